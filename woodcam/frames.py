@@ -153,6 +153,17 @@ def block_to_pixel(face: str, points_mm: ArrayLike, image_shape: ArrayLike,
 
     The coordinate normal to the face is ignored (orthographic projection along the normal).
 
+    Parameters
+    ----------
+    face : FaceName or Mokume letter
+        ``"front"``, ``"top"``, ... (:data:`FACES`) or ``"A"``-``"F"`` (:data:`MOKUME_LETTER`).
+    points_mm : (..., 3) float
+        Points in mm in the block frame (origin bottom-front-left, X width, Y depth, Z up).
+    image_shape : (n_rows, n_cols)
+        The face image's size in pixels.
+    size_mm : (W, D, H)
+        The block's size in mm.
+
     Returns
     -------
     rows, cols : (...,) float, continuous pixel coordinates.

@@ -165,6 +165,32 @@ def preview_part(source: object, stock: Stock | Callable[[], Stock], out_glb: Pa
     """Carve ``source`` (anything :func:`woodcam.cad.load_part` takes) out of ``stock``, bake it
     and write ``out_glb`` (+ ``.obj``/``.mtl``/``.png`` and a rendered ``*_view.png``).
 
+    Parameters
+    ----------
+    source : part
+        A ``.py``/``.step``/``.stl``/... path or a CAD object, in mm in the block frame.
+    stock : Stock or callable
+        The block (:func:`woodcam.open_stock`), or a function returning it (below).
+    out_glb : path
+        The ``.glb`` to write (its folder is made); the other files take its stem.
+    texels_per_mm : float
+        Texture density of the bake (texels per mm of surface; 10 = 0.1 mm texels).
+    obj : bool
+        Also write ``NAME.obj`` with its ``.mtl`` and texture PNG beside ``out_glb``.
+    screenshot : bool
+        Also render the view off screen to ``NAME_view.png`` beside ``out_glb``.
+    progress : bool
+        A progress bar on stderr, on a terminal only; off by default.
+    obj_units, obj_up : str
+        The OBJ's length unit (``"m"``, ``"mm"``, ...) and up axis (``"y"`` or ``"z"``); the GLB is
+        always metres, Y up, as glTF specifies.
+    max_atlas_px : int
+        The largest texture side in pixels; a larger bake lowers ``texels_per_mm`` and says so.
+    tolerance_mm : float, optional
+        Chord tolerance of the CAD tessellation, mm; default scaled to the part and the texel.
+    max_triangles : int, optional
+        The tessellation's triangle budget (default :data:`woodcam.tolerances.MAX_PART_TRIANGLES`).
+
     ``place`` lists placement operations applied to the loaded part before carving
     (:mod:`woodcam.cad.place`, e.g. ``["rotate:x:90", "center", "drop"]``); the resulting
     4 x 4 matrix is recorded in the GLB metadata as ``placement``; ``place_as_typed``: the same
@@ -229,7 +255,36 @@ def preview_mesh(mesh: Mesh, stock: Stock, out_glb: PathLike, *, texels_per_mm: 
                  obj_units: str = "m", obj_up: str = "y",
                  max_atlas_px: int = DEFAULT_MAX_ATLAS_PX, part_report: bool = False) -> PartPreview:
     """Bake an already carved watertight ``mesh`` (block frame, mm) and write the files: the GLB
-    in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up."""
+    in metres, Y up (glTF's convention); the OBJ in ``obj_units`` with ``obj_up`` up.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        The carved part's surface (``carve(part, stock.size_mm).mesh``), block frame, mm.
+    stock : Stock
+        The block it is carved from (:func:`woodcam.open_stock`): its wood colours the texture.
+    out_glb : path
+        The ``.glb`` to write (its folder is made); the other files take its stem.
+    texels_per_mm : float
+        Texture density of the bake (texels per mm of surface; 10 = 0.1 mm texels).
+    obj : bool
+        Also write ``NAME.obj`` with its ``.mtl`` and texture PNG beside ``out_glb``.
+    screenshot : bool
+        Also render the view off screen to ``NAME_view.png`` beside ``out_glb``.
+    progress : bool
+        A progress bar on stderr, on a terminal only; off by default.
+    obj_units, obj_up : str
+        The OBJ's length unit (``"m"``, ``"mm"``, ...) and up axis (``"y"`` or ``"z"``); the GLB is
+        always metres, Y up, as glTF specifies.
+    max_atlas_px : int
+        The largest texture side in pixels; a larger bake lowers ``texels_per_mm`` and says so.
+    result : PartPreview, optional
+        A result to fill in (its timings and warnings so far) instead of a new one.
+    metadata : dict, optional
+        JSON-serialisable extras stored in the GLB's ``woodcam`` metadata (:func:`read_glb_metadata`).
+    part_report : bool
+        Also write the part report (knots, pith, end grain, grain runout) beside ``out_glb``.
+    """
     import trimesh
 
     from .bake import bake

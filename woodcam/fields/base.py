@@ -63,6 +63,13 @@ def evaluate(field: GrowthFieldLike, points_mm: ArrayLike, batch: int = MAX_BATC
              workers: int = 1) -> np.ndarray:
     """Evaluate ``field`` on ``(n, 3)`` points in bounded batches; returns ``years : (n,)``.
 
+    ``field`` is any growth field (``field(points_mm (n, 3)) -> years (n,)``, e.g. a
+    ``Stock``'s ``wood.field`` or :func:`woodcam.fit_block`'s result); ``points_mm`` are
+    ``(n, 3)`` finite points in mm in the block frame (``docs/conventions.md``: origin at the
+    block's bottom-front-left corner, X width, Y depth, Z up); ``years`` is growth time since
+    the pith (NaN where the field has no value, e.g. outside a fitted grid). ``batch``: points
+    per call of ``field`` (bounds its memory).
+
     ``workers > 1``: the first share of the points is evaluated here while a forked process
     evaluates the rest (:func:`woodcam._parallel.beside`), for a large grid of a field that is
     safe to use after a fork (the fitted fields; not a torch net, whose thread pool is not).

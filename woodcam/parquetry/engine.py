@@ -246,10 +246,14 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
 
     Parameters
     ----------
-    targets : list of (h, w, 3) float RGB in [0, 1] (or one array)
+    targets : list of (h, w, 3) float RGB in [0, 1] (or one array); (h, w) grey and uint8 0..255
+        images are taken too (uint8 scaled by 1/255)
     veneers : list of :class:`Veneer` (any resolution; resampled to ``params.px_per_mm``)
     params : :class:`ParquetryParams` (Table 1 defaults)
-    progress : progress bars over the sheets' rotations and the patches
+    names : list of str, optional
+        One name per target, for its messages and files (default ``target0``, ``target1``, ...)
+    progress : progress bars over the sheets' rotations and the patches (stderr, a terminal only;
+        off by default)
     seams : cut optimal seams in the overlaps (eq. 8-9); False keeps square patches, matched
         and placed with their overlap all the same (the matching of a seamed run, as the bench
         times it); ``overlap_mm=0`` matches and places them square, spending no wood round
