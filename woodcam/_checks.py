@@ -101,6 +101,18 @@ def received(value, limit: int = 80) -> str:
     return text if len(text) <= limit else text[:limit] + "..."
 
 
+def not_a_mesh(what: str, value: object, fix: str, *, loads: bool = True) -> WoodcamError:
+    """The error for ``value`` given where a ``trimesh.Trimesh`` is taken: ``what`` names the
+    argument; a path (str or Path) is shown and, with ``loads``, told to be loaded first (a
+    notebook passes the file name, as the command line takes it); otherwise ``fix`` ends it."""
+    got = type(value).__name__
+    if isinstance(value, (str, os.PathLike)):
+        got += f" {received(os.fspath(value))}"
+        if loads:
+            fix = f"load the file first: trimesh.load({os.fspath(value)!r}, force='mesh')"
+    return WoodcamError(f"{what} must be a trimesh.Trimesh; got {got}; {fix}")
+
+
 def numbers_fix(value, name: str) -> str:
     """The fix of a ``value`` that :func:`as_floats` refused for its kind of elements: complex
     numbers -> take the real parts if meant, text -> convert it; ``""`` for anything else (the

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -52,7 +53,7 @@ from typing import Any, Literal, get_args
 
 import numpy as np
 
-from woodcam._checks import check_bool
+from woodcam._checks import check_bool, not_a_mesh
 from woodcam._repr import summary_repr
 from woodcam._types import Mesh, WoodLike
 from woodcam.errors import WoodcamError, WoodcamWarning
@@ -460,6 +461,8 @@ def _check_args(mesh, wood, texels_per_mm, max_atlas_px, padding_px, normals, *,
                 picture: bool = False) -> None:
     """The arguments of :func:`bake` checked at the door (``picture``: a picture is baked, no
     wood, as :func:`rebake_texture`)."""
+    if isinstance(mesh, (str, os.PathLike)):  # was "got str with 0 faces"
+        raise not_a_mesh("bake: mesh", mesh, "")
     faces = getattr(mesh, "faces", None)
     if faces is None or len(faces) == 0:
         raise WoodcamError(

@@ -1580,3 +1580,30 @@ def test_stem_pith_tool_profile_and_ramp_take_real_numbers():
     assert np.array_equal(stem.pith_mm([0, 10]), [[20, 15, 10], [20, 15, 20]])
     assert ball.profile([0.0])[0] == 0.0 and ball.profile([5.0])[0] == np.inf
     assert app.ramp([0.0, 0.95]).shape == (2, 3)
+
+
+@pytest.mark.parametrize("as_path", [False, True])
+def test_a_file_name_where_a_mesh_is_taken_is_told_to_be_loaded(as_path):
+    """A notebook passes the file name, as the command line takes it: woodify('x.stl', 5) said
+    "mesh must be a trimesh.Trimesh; got str" (no value, no fix), bake('x.stl', wood) "got str
+    with 0 faces", export_glb('x', ...) "got str"."""
+    from pathlib import Path
+
+    import trimesh
+
+    from woodcam import bake, crease_normals, export_glb, open_stock
+    from woodcam.woodify import woodify
+
+    name = Path("part.stl") if as_path else "part.stl"
+    load = r"got (str|PosixPath) 'part.stl'; load the file first: trimesh.load\('part.stl', force='mesh'\)"
+    with pytest.raises(WoodcamError, match="^mesh must be a trimesh.Trimesh; " + load):
+        woodify(name, 5, growth_mm=2, resolution=16)
+    with pytest.raises(WoodcamError, match=r"^obstacles\[0\] must be a trimesh.Trimesh; " + load):
+        woodify(trimesh.creation.icosphere(1, 10.0), 5, growth_mm=2, resolution=16, obstacles=[name])
+    with pytest.raises(WoodcamError, match="^bake: mesh must be a trimesh.Trimesh; " + load):
+        bake(name, open_stock("builtin:flat-sawn").wood)
+    with pytest.raises(WoodcamError, match="^crease_normals: mesh must be a trimesh.Trimesh; " + load):
+        crease_normals(name)
+    with pytest.raises(WoodcamError, match=r"^export_glb: mesh must be a trimesh.Trimesh; got (str|PosixPath) "
+                       r"'part.stl'; pass the baked surface: bake\(mesh, wood\).mesh .*load_textured"):
+        export_glb(name, "out.glb")

@@ -40,7 +40,7 @@ from typing import get_args
 import numpy as np
 
 from woodcam._atomic import atomic_files, check_output_path, write_bytes
-from woodcam._checks import check_number, check_path
+from woodcam._checks import check_number, check_path, not_a_mesh
 from woodcam.errors import WoodcamError
 from woodcam.frames import (BLOCK_TO_GLTF, GLTF_ROOT_NODE, OBJ_HEADER, ObjUnits, ObjUp,
                             foreign_gltf_in_block_frame, obj_header_transform, obj_transform,
@@ -112,7 +112,8 @@ def _require_textured(mesh, func: str):
     import trimesh
 
     if not isinstance(mesh, trimesh.Trimesh):
-        raise WoodcamError(f"{func}: mesh must be a trimesh.Trimesh; got {type(mesh).__name__}")
+        raise not_a_mesh(f"{func}: mesh", mesh, "pass the baked surface: bake(mesh, wood).mesh (a file woodcam "
+                         "wrote reads back with load_textured(path))", loads=False)
     if len(mesh.faces) == 0:
         raise WoodcamError(f"{func}: mesh has no triangles ({len(mesh.vertices)} vertices); nothing to "
                            "write; pass a surface with at least one triangle")
@@ -161,7 +162,7 @@ def crease_normals(mesh: Mesh, crease_angle_deg: float | None = None) -> Mesh:
     from woodcam.tolerances import CREASE_ANGLE_DEG, CREASE_WELD_MM
 
     if not isinstance(mesh, trimesh.Trimesh):
-        raise WoodcamError(f"mesh must be a trimesh.Trimesh; got {type(mesh).__name__}")
+        raise not_a_mesh("crease_normals: mesh", mesh, "pass a surface mesh, e.g. bake(mesh, wood).mesh")
     # a string ('30') was float()'s number without a word
     angle = CREASE_ANGLE_DEG if crease_angle_deg is None else check_number(
         crease_angle_deg, "crease_normals: crease_angle_deg", lo=0.0, hi=180.0,

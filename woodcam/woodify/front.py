@@ -36,7 +36,7 @@ from typing import Literal
 
 import numpy as np
 
-from .._checks import check_number
+from .._checks import check_number, not_a_mesh
 from .._repr import summary_repr
 from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE
@@ -173,7 +173,7 @@ def check_watertight(mesh, name: str, *, fix: str | None = None):
     import trimesh
 
     if not isinstance(mesh, trimesh.Trimesh):
-        raise WoodcamError(f"{name} must be a trimesh.Trimesh; got {type(mesh).__name__}")
+        raise not_a_mesh(name, mesh, "pass a closed (watertight) mesh, e.g. trimesh.creation.icosphere(3, 20.0)")
     if len(mesh.faces) == 0:
         raise WoodcamError(f"{name} has no triangles; give a closed (watertight) mesh")
     bad = ~np.isfinite(np.asarray(mesh.vertices, float)).all(axis=1)
