@@ -1607,3 +1607,22 @@ def test_a_file_name_where_a_mesh_is_taken_is_told_to_be_loaded(as_path):
     with pytest.raises(WoodcamError, match=r"^export_glb: mesh must be a trimesh.Trimesh; got (str|PosixPath) "
                        r"'part.stl'; pass the baked surface: bake\(mesh, wood\).mesh .*load_textured"):
         export_glb(name, "out.glb")
+
+
+def test_refusals_a_notebook_walk_met_without_a_fix_now_say_one(tmp_path):
+    """Each said the rule and the value and stopped: ParquetryParams(px_per_mm=nan) "parquetry
+    parameter px_per_mm must be a finite number; got nan", Brush(..., -1) "brush radius_mm must be
+    > 0 (mm); got -1", read_mokume('/nope') "... '/nope' is not a directory", read_glb_metadata of
+    a missing file "GLB file '...': cannot read it (No such file or directory)"."""
+    import woodcam as w
+
+    cases = [
+        (lambda: w.ParquetryParams(px_per_mm=float("nan")),
+         r"px_per_mm must be a finite number; got nan; leave it out for the default, px_per_mm=4.0"),
+        (lambda: w.Brush((0, 0, 0), -1), r"radius_mm must be > 0 \(mm\); got -1; .*radius_mm=5"),
+        (lambda: w.read_mokume(tmp_path / "nope"), r"is not a directory; give the folder holding A_col.png"),
+        (lambda: w.read_glb_metadata(tmp_path / "nope.glb"), r"cannot read it \(.*\); check the path"),
+    ]
+    for call, said in cases:
+        with pytest.raises(WoodcamError, match=said):
+            call()

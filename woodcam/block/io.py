@@ -526,7 +526,8 @@ def read_mokume(folder: PathLike, size_mm: ArrayLike = MOKUME_DEFAULT_SIZE_MM, *
                            f"sample folder ({str(folder)!r}) is a cube, its faces square photos: give the cube's "
                            f"side, one number, e.g. --size-mm {side:g}")
     if not folder.is_dir():
-        raise WoodcamError(f"folder must be a Mokume sample folder; {str(folder)!r} is not a directory")
+        raise WoodcamError(f"folder must be a Mokume sample folder; {str(folder)!r} is not a directory; give the "
+                           "folder holding A_col.png .. F_col.png, e.g. shared/data/mokume/H11")
     faces = {}
     for face in FACES:
         letter = MOKUME_LETTER[face]

@@ -581,7 +581,8 @@ def read_glb_metadata(path: PathLike) -> dict:
     try:
         data = path.read_bytes()
     except OSError as err:
-        raise WoodcamError(f"GLB file {str(path)!r}: cannot read it ({err.strerror})") from err
+        raise WoodcamError(f"GLB file {str(path)!r}: cannot read it ({err.strerror}); check the path: a .glb "
+                           "written by woodcam bake or export_glb") from err
     # the file as the user gave it, not this function's name (a command-line user read
     # "read_glb_metadata: 'x.glb' is 3 bytes ..." of the file they typed)
     tree = glb_json(data, f"GLB file {str(path)!r}")

@@ -118,7 +118,8 @@ class ParquetryParams:
     def check(self) -> ParquetryParams:
         """Validate (done when made; call again after changing a field); returns self."""
         for f in fields(self):  # the types first: a job file's "abc" or NaN fails here, by name
-            setattr(self, f.name, _check_type(f"parquetry parameter {f.name}", getattr(self, f.name), str(f.type)))
+            setattr(self, f.name, _check_type(f"parquetry parameter {f.name}", getattr(self, f.name), str(f.type),
+                                              fix=f"leave it out for the default, {f.name}={f.default!r}"))
         if not 1 <= self.n_rot <= 360:  # 1e9 filled the memory before the search's own estimate
             raise WoodcamError(f"n_rot must be in [1, 360] (rotated copies of each sheet, sec. 3.2); got {self.n_rot}")
         if not 0 < self.px_per_mm <= 50:  # 200 px/mm asked OpenCV for 1.6 GB on a 100 mm veneer
@@ -239,10 +240,11 @@ class ParquetryParams:
         return round(self.overlap * self.px_per_mm)
 
 
-def _check_type(what: str, v, annotation: str):
+def _check_type(what: str, v, annotation: str, fix: str = ""):
     """``v`` checked against the dataclass field type ``annotation`` (a string: ``float``,
     ``int | None``, ``bool``, a Literal alias): numbers finite, ints whole (returned as int:
-    JSON may write 15.0), bools true bools; else a WoodcamError naming ``what``."""
+    JSON may write 15.0), bools true bools; else a WoodcamError naming ``what``, ending with
+    ``fix`` when given."""
     if v is None and "None" in annotation:
         return v
     kind = annotation.split("|")[0].strip()
@@ -257,7 +259,7 @@ def _check_type(what: str, v, annotation: str):
         return v
     if not ok:
         rule = {"bool": "true or false", "float": "a finite number", "int": "a whole number"}[kind]
-        raise WoodcamError(f"{what} must be {rule}; got {v!r}")
+        raise WoodcamError(f"{what} must be {rule}; got {v!r}" + (f"; {fix}" if fix else ""))
     if kind == "bool":
         return bool(v)
     return int(v) if kind == "int" else (v if isinstance(v, (int, float)) else float(v))

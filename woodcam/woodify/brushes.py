@@ -64,7 +64,8 @@ class Brush:
             if isinstance(v, bool) or not isinstance(v, numbers.Real):
                 raise WoodcamError(f"brush {name} must be a number; got {v!r}; e.g. Brush((0, 0, 10), radius_mm=5)")
         if not (np.isfinite(self.radius_mm) and self.radius_mm > 0):
-            raise WoodcamError(f"brush radius_mm must be > 0 (mm); got {self.radius_mm!r}")
+            raise WoodcamError(f"brush radius_mm must be > 0 (mm); got {self.radius_mm!r}; the stroke's reach in mm, "
+                               "e.g. Brush((0, 0, 10), radius_mm=5)")
         if not (np.isfinite(self.gain) and self.gain > 0):
             raise WoodcamError(f"brush gain must be > 0 (1 = unchanged speed); got {self.gain!r}")
         if not 0.0 <= self.strength < 1.0:
