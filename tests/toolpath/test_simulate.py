@@ -373,3 +373,11 @@ def test_the_bull_noses_contact_solve_finds_the_lowest_point():
         best = min(f(float(x)) for x in grid)
         # the grid's own spacing (<= 0.75 um) bounds how far its best is above the true one
         assert f(w) <= best + 1e-9, (rc, s, d, w)
+
+
+def test_the_cell_size_is_plain_floats():
+    """cell_mm was (np.float64(0.5), np.float64(0.5)), and so it showed in a notebook's repr of the
+    result, beside size_mm's plain (100.0, 80.0, 50.0)."""
+    res = simulate(read_gcode("G0 X10 Y15 Z2\nG1 Z-1 F300\nX30\n"), FlatEndMill(6), SIZE, resolution_mm=0.5)
+    assert all(type(v) is float for v in (*res.cell_mm, *res.size_mm)), res.cell_mm
+    assert "cell_mm=(0.5, 0.5)" in repr(res)

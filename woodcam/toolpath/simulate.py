@@ -413,7 +413,7 @@ def simulate(program: Program, tools: Mapping[int, Tool] | Tool, size_mm: ArrayL
     stats = {"moves": len(program), "moves_cutting_window": n_active, "cell_updates": cells,
              "wall_s": wall, "moves_per_s": len(program) / max(wall, 1e-12),
              "cell_updates_per_s": cells / max(wall, 1e-12), "grid": (ny, nx)}
-    return SimResult(hm, (float(W), float(D), float(H)), (dx, dy), report, stats, line_map)
+    return SimResult(hm, (float(W), float(D), float(H)), (float(dx), float(dy)), report, stats, line_map)
 
 
 def _clip_segments(a, b, lo, hi):
