@@ -171,21 +171,10 @@ def preview_part(source: object, stock: Stock | Callable[[], Stock], out_glb: Pa
         A ``.py``/``.step``/``.stl``/... path or a CAD object, in mm in the block frame.
     stock : Stock or callable
         The block (:func:`woodcam.open_stock`), or a function returning it (below).
-    out_glb : path
-        The ``.glb`` to write (its folder is made); the other files take its stem.
-    texels_per_mm : float
-        Texture density of the bake (texels per mm of surface; 10 = 0.1 mm texels).
-    obj : bool
-        Also write ``NAME.obj`` with its ``.mtl`` and texture PNG beside ``out_glb``.
-    screenshot : bool
-        Also render the view off screen to ``NAME_view.png`` beside ``out_glb``.
-    progress : bool
-        A progress bar on stderr, on a terminal only; off by default.
-    obj_units, obj_up : str
-        The OBJ's length unit (``"m"``, ``"mm"``, ...) and up axis (``"y"`` or ``"z"``); the GLB is
-        always metres, Y up, as glTF specifies.
-    max_atlas_px : int
-        The largest texture side in pixels; a larger bake lowers ``texels_per_mm`` and says so.
+    out_glb, texels_per_mm, obj, screenshot, progress, obj_units, obj_up, max_atlas_px
+        As :func:`preview_mesh` takes them: the ``.glb`` to write (the other files take its
+        stem), the texture density (texels per mm), the OBJ and the rendered view beside it, a
+        progress bar (off by default), the OBJ's unit and up axis, the largest texture side.
     tolerance_mm : float, optional
         Chord tolerance of the CAD tessellation, mm; default scaled to the part and the texel.
     max_triangles : int, optional
