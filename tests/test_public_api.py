@@ -132,6 +132,15 @@ def test_fields_and_wood_show_what_they_are():
     assert "block_origin_mm=array([0.0, 0.0, 0.0])" in texts[2]
 
 
+def test_an_appearance_shows_its_species_by_name():
+    """A knotty stock's Wood repr was one line of 1098 characters, a third of it the Species'
+    ten numbers and its source sentence, printed through the ColorMapAppearance."""
+    text = repr(woodcam.open_stock("builtin:knotty").wood)
+    assert "appearance=ColorMapAppearance(species=<Species 'spruce'>, axis_luts=None" in text
+    assert "earlywood_rgb" not in text and "source=" not in text and len(text) < 800, text
+    assert repr(woodcam.ColorMapAppearance("walnut")).startswith("ColorMapAppearance(species=<Species 'walnut'>, ")
+
+
 def test_the_python_entry_points_the_readme_names_are_annotated():
     """The README sends a Python user to woodcam.woodify.woodify (and woodcam.pipeline.preview_part);
     woodify left mesh, up, obstacles, vertex_gain, vertex_direction and obstacle_names bare."""

@@ -259,8 +259,6 @@ class ColorMapAppearance:
         Set by the block spec, not an appearance parameter.
     """
 
-    __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
-
     species: Species | str = "oak"
     axis_luts: np.ndarray | None = None
     knot_lut: np.ndarray | None = None
@@ -272,6 +270,15 @@ class ColorMapAppearance:
     knot_darkening_dead: InitVar[float | None] = None
     dead_outline_rgb: InitVar[tuple[float, float, float] | None] = None
     texture_frame: LogFrame | None = None
+
+    def __repr__(self) -> str:
+        # arrays as shapes (summary_repr), and the species by its name: its ten numbers and its
+        # source sentence made a knotty stock's Wood repr one line of ~1100 characters
+        text = summary_repr(self)
+        species = self.species
+        if isinstance(species, Species):
+            text = text.replace(f"species={species!r}", f"species=<Species {species.name!r}>", 1)
+        return text
 
     def __post_init__(self, knot_darkening_alive=None, knot_darkening_dead=None,
                       dead_outline_rgb=None):
