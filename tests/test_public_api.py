@@ -185,3 +185,28 @@ def test_the_walk_through_calls_document_every_parameter():
                     if not re.search(rf"\b{re.escape(p)}\b", doc)]
     assert not missing, "document:\n" + "\n".join(missing)
     assert "block frame" in inspect.getdoc(woodcam.evaluate) and "mm" in inspect.getdoc(woodcam.evaluate)
+
+
+def test_the_sub_packages_exports_are_annotated():
+    """What a sub-package exports (woodcam/<pkg>/__init__.py __all__) is a Python door too, outside
+    woodcam.__all__: 47 of them left parameters or the return bare (woodify.propagate,
+    inference.score_face, logs.fit_*, view.build_scene, fields.check_points, ...)."""
+    import importlib
+    import pkgutil
+
+    missing = []
+    for info in pkgutil.iter_modules(woodcam.__path__):
+        if not info.ispkg or info.name.startswith("_") or info.name == "examples":
+            continue
+        module = importlib.import_module(f"woodcam.{info.name}")
+        for name in getattr(module, "__all__", ()):
+            f = getattr(module, name)
+            if not inspect.isfunction(f):
+                continue
+            sig = inspect.signature(f)
+            bare = [p for p, v in sig.parameters.items() if v.annotation is inspect.Parameter.empty
+                    and v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)]
+            if bare or sig.return_annotation is inspect.Signature.empty:
+                missing.append(f"woodcam.{info.name}.{name}: {bare}"
+                               f"{' (no return)' if sig.return_annotation is inspect.Signature.empty else ''}")
+    assert not missing, "add type hints:\n" + "\n".join(missing)

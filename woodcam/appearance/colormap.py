@@ -198,7 +198,7 @@ _CITED: dict[str, Species] = {s.name: s for s in (
 SPECIES: dict[str, Species] = {**_LEGACY, **_CITED}
 
 
-def get_species(species) -> Species:
+def get_species(species: Species | str) -> Species:
     """Return a :class:`Species` from a preset name or a Species."""
     if isinstance(species, Species):
         return species

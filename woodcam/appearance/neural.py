@@ -30,6 +30,11 @@ from .orientation import axis_weights
 from .translation import Quality, TranslationNet, train_translation, translation_spec
 from .volumes import (PLANE_AXES, ColorVolumes, VolumeGrid, cache_key, face_pair, guide_slopes,
                       point_guide, translate_volume, years_volume)
+from .._types import AppearanceLike, GrowthFieldLike, PathLike
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..block import Block
 
 Orientation = Literal["dependent", "agnostic"]
 Source = Literal["auto", "arf", "ring_map"]
@@ -180,10 +185,11 @@ def train_axis_networks(block, grid: VolumeGrid, spec, *, field=None, source: st
     return {"nets": nets, "notes": notes}
 
 
-def fit_neural_appearance(block, field=None, *, resolution: int = 128, quality: Quality = "normal",
+def fit_neural_appearance(block: Block, field: GrowthFieldLike | None = None, *,
+                          resolution: int = 128, quality: Quality = "normal",
                           epochs: int | None = None, seed: int = 0,
                           orientation: Orientation = "dependent", source: Source = "auto",
-                          cache_dir=None, progress: bool = True,
+                          cache_dir: PathLike | None = None, progress: bool = True,
                           threads: int | None = 1, detail: bool = True) -> NeuralAppearance:
     """Learn a block's appearance from its photos and build its colour volumes (cached).
 
@@ -337,8 +343,8 @@ def load_nets(path) -> list[TranslationNet]:
     return out
 
 
-def block_appearance(block, field, kind: AppearanceKind = "colormap", *, species: str = "oak",
-                     **neural_params):
+def block_appearance(block: Block, field: GrowthFieldLike, kind: AppearanceKind = "colormap", *,
+                     species: str = "oak", **neural_params) -> AppearanceLike:
     """The appearance of ``block``: its photo-fitted colour map or its neural volumes.
 
     ``kind="neural"`` on a block without photos falls back to the species colour map and says

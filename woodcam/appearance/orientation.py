@@ -18,6 +18,7 @@ import numba
 import numpy as np
 
 from ..errors import WoodcamError
+from .._types import ArrayLike
 
 
 @numba.njit(cache=True, inline="always")
@@ -37,7 +38,7 @@ def _weights_kernel(n, out):  # pragma: no cover - compiled
         out[i, 0], out[i, 1], out[i, 2] = eq10_weights(n[i, 0], n[i, 1], n[i, 2])
 
 
-def axis_weights(normals) -> np.ndarray:
+def axis_weights(normals: ArrayLike) -> np.ndarray:
     """Eq. 10 weights ``(n, 3)`` for the colourings of the planes normal to X, Y, Z.
 
     Column ``k`` weighs the colouring seen on a plane whose normal is block axis ``k``
@@ -52,7 +53,7 @@ def axis_weights(normals) -> np.ndarray:
     return out
 
 
-def blend_axis_colors(rgb_yz, rgb_zx, rgb_xy, normals) -> np.ndarray:
+def blend_axis_colors(rgb_yz: ArrayLike, rgb_zx: ArrayLike, rgb_xy: ArrayLike, normals: ArrayLike) -> np.ndarray:
     """Eq. 10: blend three ``(n, 3)`` colourings by the surface ``normals : (n, 3)``."""
     w = axis_weights(normals)
     return w[:, 0:1] * rgb_yz + w[:, 1:2] * rgb_zx + w[:, 2:3] * rgb_xy

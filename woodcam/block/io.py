@@ -588,7 +588,7 @@ def _load_image(src, what: str) -> np.ndarray:
     return np.asarray(src)
 
 
-def block_from_images(size_mm, photos: dict | None = None, ring_maps: dict | None = None, *,
+def block_from_images(size_mm: ArrayLike, photos: dict | None = None, ring_maps: dict | None = None, *,
                       name: str = "block", meta: dict | None = None) -> Block:
     """Build a (real) block from face images, ready for :func:`write_block`.
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from collections.abc import Sequence
 
 #: Reference-map grey level taken as ring (the fitter's RING_MAP_THRESHOLD, 0.5).
 REFERENCE_THRESHOLD = 0.5
@@ -47,7 +48,7 @@ class RidgeScore:
 
 
 def ridge_scores(detected_px: np.ndarray, reference_px: np.ndarray,
-                 thresholds=SCORE_THRESHOLDS_PX) -> RidgeScore:
+                 thresholds: Sequence[float] = SCORE_THRESHOLDS_PX) -> RidgeScore:
     """Score detected points ``(n, 2)`` against reference ridge pixels ``(k, 2)`` (module docstring)."""
     from scipy.spatial import cKDTree
 

@@ -32,7 +32,7 @@ class GrowthField(Protocol):
     def __call__(self, points_mm: np.ndarray) -> np.ndarray: ...
 
 
-def check_points(points_mm, name: str = "points_mm", *, frame: str = "block") -> np.ndarray:
+def check_points(points_mm: ArrayLike, name: str = "points_mm", *, frame: str = "block") -> np.ndarray:
     """Return ``points_mm`` as a float64 ``(n, 3)`` array of finite points within
     :data:`~woodcam.tolerances.POINT_BOUND_MM` of the origin, or raise a clear error.
 

@@ -594,7 +594,8 @@ _MOVED_TO_SHADING = ("alive_darkening", "dead_darkening")
 from .placement import PlacedField, place_block_in_log  # noqa: E402,F401  (re-exported)
 
 
-def block_at_knot(log, knot_index: int, size_mm, *, front_r_mm: float | None = None):
+def block_at_knot(log: LogSkeleton, knot_index: int, size_mm: ArrayLike, *,
+                  front_r_mm: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Placement ``(origin_mm, rotation)`` of a ``W x D x H`` block whose front face (Y = 0)
     is a tangential face of ``log`` cut through knot ``knot_index``.
 

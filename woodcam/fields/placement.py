@@ -134,7 +134,8 @@ class PlacedField:
                                                       None if ref is None else tuple(ref)))
 
 
-def place_block_in_log(log_field, origin_mm, rotation=None) -> PlacedField:
+def place_block_in_log(log_field: GrowthFieldLike, origin_mm: ArrayLike,
+                       rotation: ArrayLike | None = None) -> PlacedField:
     """Place a block in a log: block point ``p`` sits at ``origin_mm + rotation @ p`` (log
     frame, mm). See :class:`PlacedField`."""
     return PlacedField(log_field, origin_mm, rotation)

@@ -324,7 +324,7 @@ class LogSkeleton:
                                "(woodcam.logs.write_log) writes them") from err
 
 
-def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots=(), *,
+def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots: Sequence[BranchStrand] = (), *,
                z_step_mm: float = 10.0, azimuths: int = 36, name: str = "simple") -> LogSkeleton:
     """A straight cylindrical log (pith on the ``z`` axis, constant radius) with ``knots``:
     the analytic test case and a starting point for hand-made logs."""

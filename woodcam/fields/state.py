@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import WoodcamError
+from .._types import GrowthFieldLike
 
 
 def field_type(obj) -> str:
@@ -50,7 +51,7 @@ def is_saveable(field) -> bool:
             and hasattr(type(field), "from_dict"))
 
 
-def field_to_state(field) -> dict:
+def field_to_state(field: GrowthFieldLike) -> dict:
     """``{"type": "module:QualName", "state": field.to_dict()}`` for a woodcam field class."""
     kind = field_type(field)
     if not is_saveable(field):
@@ -65,7 +66,7 @@ def field_to_state(field) -> dict:
 _MOVED = {"woodcam.synth:AnalyticLogField": "woodcam.fields.analytic:AnalyticLogField"}
 
 
-def field_from_state(d: dict, *, fix: str | None = None):
+def field_from_state(d: dict, *, fix: str | None = None) -> GrowthFieldLike:
     """Inverse of :func:`field_to_state`.
 
     fix : the fix a malformed ``d`` is refused with (a type this version lacks says "upgrade

@@ -22,9 +22,11 @@ from ..errors import WoodcamError
 from ..fields.grid import GridField
 from ..frames import check_size
 from ..tolerances import BAKE_MARGIN_MM, BAKE_SMOOTH_DEPTH_MM, BAKE_SMOOTH_SPACING_MM, BAKE_SPACING_MM
+from .._types import ArrayLike, GrowthFieldLike
 
 
-def bake(field, size_mm, spacing_mm: float = BAKE_SPACING_MM, margin_mm: float = BAKE_MARGIN_MM,
+def bake(field: GrowthFieldLike, size_mm: ArrayLike, spacing_mm: float = BAKE_SPACING_MM,
+         margin_mm: float = BAKE_MARGIN_MM,
          workers: int = 1) -> GridField:
     """Sample ``field`` (``(n, 3) mm -> (n,) years``) on a grid over the block ``[0, size_mm]``.
 

@@ -36,6 +36,7 @@ from ..frames import face_pixel_points
 from ..tolerances import HOLDOUT_LINE_STEP_PX, HOLDOUT_THRESHOLDS_PX, RING_MAP_THRESHOLD
 from .fit import METHODS, fit_block
 from .observations import _pixel_index, knot_exclusion
+from .._types import GrowthFieldLike
 
 if TYPE_CHECKING:
     from ..block import Block
@@ -151,7 +152,8 @@ class FaceScore:
         return confidence_summary(conf, _nearest(self.lines, self.ridge.astype(float)))
 
 
-def score_face(field, block, face: str, thresholds=HOLDOUT_THRESHOLDS_PX) -> FaceScore:
+def score_face(field: GrowthFieldLike, block: Block, face: str,
+               thresholds: Sequence[float] = HOLDOUT_THRESHOLDS_PX) -> FaceScore:
     """Score ``field``'s ring lines on ``face`` of ``block`` against that face's ring map."""
     excl, ridge = _face_reference(block, face)
     f = block.faces[face]

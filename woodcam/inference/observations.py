@@ -19,6 +19,11 @@ from ..fields.rings import resample_polyline
 from ..frames import FACES, check_face, face_image_size_mm, pixel_to_block
 from ..tolerances import (FACE_PIXEL_ASPECT_RTOL, KNOT_MASK_MARGIN_MM, RING_MAP_MAX_WIDTH_FACTOR,
                           RING_MAP_MIN_PIECE_PX, RING_MAP_THRESHOLD, TRACE_SAMPLE_STEP_MM)
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..block import Block
 
 
 @dataclass
@@ -101,7 +106,7 @@ def _ring_map_components(ring_map: np.ndarray, threshold: float, exclude=None):
     return [c for c in comps if len(c) >= RING_MAP_MIN_PIECE_PX]
 
 
-def gather_observations(block, faces=None, step_mm: float = TRACE_SAMPLE_STEP_MM,
+def gather_observations(block: Block, faces: Sequence[str] | None = None, step_mm: float = TRACE_SAMPLE_STEP_MM,
                         ring_map_threshold: float = RING_MAP_THRESHOLD) -> RingObservations:
     """Collect ring-boundary points from ``block``'s traces (preferred) or ring maps.
 

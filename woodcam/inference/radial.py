@@ -48,6 +48,7 @@ from ..fields.base import check_points
 from ..tolerances import (NUMBERING_MIN_STEP, NUMBERING_RESEARCHES, NUMBERING_STEP_MARGIN, RING_HISTORY_MIN_STEP,
                           RING_HISTORY_PRIOR_POINTS, RING_HISTORY_ROUNDS)
 from .observations import RingObservations
+from .._types import ArrayLike, GrowthFieldLike
 
 
 # -- the field --------------------------------------------------------------------------------
@@ -827,14 +828,14 @@ def _relabel(obs: RingObservations, field: RadialField) -> tuple[RingObservation
     return RingObservations(obs.points_mm, years, obs.group, obs.face), changed
 
 
-def number_observations(obs: RingObservations, field) -> RingObservations:
+def number_observations(obs: RingObservations, field: GrowthFieldLike) -> RingObservations:
     """Label every ring group with the integer nearest ``field``'s median growth time on it
     (e.g. to hand unlabelled ring maps to a method that needs years, numbered by a radial fit)."""
     years = np.round(_group_medians(field(obs.points_mm), obs.group, obs.n_groups))
     return RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
 
 
-def fit_radial(obs: RingObservations, size_mm, K: int = 12, M: int = 1, ridge: float = 1e-8,
+def fit_radial(obs: RingObservations, size_mm: ArrayLike, K: int = 12, M: int = 1, ridge: float = 1e-8,
                max_relabel_rounds: int = 2, seed: int = 0, history: bool = True,
                **search) -> RadialField:
     """Fit the radial model to labelled or unlabelled ring observations of a block.

@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import WoodcamError
 from ..tolerances import RBF_MAX_POINTS
 from .observations import RingObservations
+from .._types import GrowthFieldLike
 
 
 def thin_out(n: int, max_points: int, seed: int = 0) -> np.ndarray:
@@ -23,7 +24,7 @@ def thin_out(n: int, max_points: int, seed: int = 0) -> np.ndarray:
 
 
 def fit_rbf(obs: RingObservations, kernel: str = "thin_plate_spline", smoothing: float = 0.0,
-            max_points: int = RBF_MAX_POINTS):
+            max_points: int = RBF_MAX_POINTS) -> GrowthFieldLike:
     """Interpolate labelled ring points with an RBF; returns a field ``(n, 3) mm -> (n,) years``.
 
     Parameters

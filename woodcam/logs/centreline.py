@@ -16,6 +16,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as C
 
 from ..errors import WoodcamError
+from .._types import ArrayLike
 
 
 def _u(l_mm, length_mm: float) -> np.ndarray:
@@ -80,7 +81,7 @@ class Centreline:
         return np.stack([np.arctan2(dy, dx), p[:, 2], np.hypot(dx, dy)], axis=1)
 
 
-def fit_centreline(l_mm, xy_mm, n_coef: int, length_mm: float | None = None) -> Centreline:
+def fit_centreline(l_mm: ArrayLike, xy_mm: ArrayLike, n_coef: int, length_mm: float | None = None) -> Centreline:
     """Least-squares Chebyshev centreline through pith samples (seed 001 §3.3).
 
     Parameters

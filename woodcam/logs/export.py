@@ -19,6 +19,7 @@ from .._checks import png_path
 from ..errors import WoodcamError
 from ..frames import BLOCK_TO_GLTF, GLTF_ROOT_NODE, stamp_gltf_asset
 from .generate import GeneratedKnot, GeneratedLog
+from .._types import PathLike
 
 #: Colours (RGBA, 0-255): debarked sapwood, a live (intergrown) knot, a dead (loose) knot.
 SURFACE_RGBA = (222, 192, 140, 255)
@@ -109,7 +110,7 @@ def knots_mesh(log: GeneratedLog, **kw) -> trimesh.Trimesh:
     return mesh
 
 
-def export_log_glb(log: GeneratedLog, path, *, surface_alpha: float = 1.0, max_rows: int = 400,
+def export_log_glb(log: GeneratedLog, path: PathLike, *, surface_alpha: float = 1.0, max_rows: int = 400,
                    max_cols: int = 180) -> Path:
     """Write ``log`` as a binary glTF: the surface mesh (node ``surface``) and the knots (``knots``).
 
@@ -166,7 +167,7 @@ def heightmap_image(log: GeneratedLog,
     return ((img - lo) / span)[::-1], (lo, hi)
 
 
-def heightmap_png(log: GeneratedLog, path, *, mode: Literal["height", "detail"] = "height") -> Path:
+def heightmap_png(log: GeneratedLog, path: PathLike, *, mode: Literal["height", "detail"] = "height") -> Path:
     """Write the heightmap (:func:`heightmap_image`) as a 16-bit grey PNG.
 
     Grey 0 and 65535 are the range's ends, stored in mm in the PNG text chunk
@@ -185,7 +186,7 @@ def heightmap_png(log: GeneratedLog, path, *, mode: Literal["height", "detail"] 
     return p
 
 
-def read_heightmap_png(path) -> np.ndarray:
+def read_heightmap_png(path: PathLike) -> np.ndarray:
     """Decode a PNG written by :func:`heightmap_png` back to mm, ``(n_l, n_theta)``, row 0 = ``l = 0``."""
     from PIL import Image
 

@@ -26,6 +26,7 @@ from scipy.optimize import least_squares
 
 from ..errors import WoodcamError
 from .knot import MAX_INCLINE, Knot, KnotShape, to_slr
+from .._types import ArrayLike, PathLike
 
 _LOGIT_CLIP = 30.0  # only guards exp() overflow; sigmoid(30) is 1 to double precision
 _INIT_LOGIT = 1.5  # start LM with ratios in [0.18, 0.82], where the sigmoid still has slope
@@ -128,7 +129,7 @@ def _init_params(slr: np.ndarray) -> np.ndarray:
     return np.r_[s0, l0, np.log(gamma), lrm, lp0, lp1, r.x]
 
 
-def fit_knot(points_lcs, *, theta_mean_rad: float | None = None, max_nfev: int = 400) -> KnotFit:
+def fit_knot(points_lcs: ArrayLike, *, theta_mean_rad: float | None = None, max_nfev: int = 400) -> KnotFit:
     """Fit the 9-parameter knot model to knot surface points (seed 001 §4.2).
 
     Parameters
@@ -241,7 +242,8 @@ class GranFitTable:
                 "rmse_median_mm": float(np.median(e)), "rmse_max_mm": float(e.max())}
 
 
-def fit_gran_knots(knots_json, *, indices=None, n_along: int = 24, n_around: int = 12) -> GranFitTable:
+def fit_gran_knots(knots_json: PathLike, *, indices: ArrayLike | None = None, n_along: int = 24,
+                   n_around: int = 12) -> GranFitTable:
     """Fit the knot model to the knots of a ``Gran_*_knots.json`` log (see module docstring).
 
     ``indices`` selects rows (default all). Each knot's sampled points are fitted independently.

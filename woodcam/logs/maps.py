@@ -43,6 +43,7 @@ from .._checks import check_bool, check_number, check_vector, received
 from .._readers import read_json_file
 from ..errors import WoodcamError
 from ..fields.skeleton import BranchStrand, LogSkeleton
+from .._types import PathLike
 
 MAP_FILES = {"stem": "stem_map.png", "height": "knot_height_map.png",
              "orientation": "knot_orientation_map.png", "state": "knot_state_map.png",
@@ -112,7 +113,7 @@ def encode_maps(log: LogSkeleton, *, stem_shape=(512, 128), knot_columns: int = 
     return {k: v.astype(np.uint8) for k, v in maps.items()}, params
 
 
-def write_maps(log: LogSkeleton, folder, **kw) -> dict:
+def write_maps(log: LogSkeleton, folder: PathLike, **kw) -> dict:
     """Write the maps of :func:`encode_maps` as PNGs plus ``map_params.json`` into ``folder``;
     returns ``{name: path}``."""
     from PIL import Image
@@ -230,7 +231,7 @@ def decode_maps(maps: dict, params: dict) -> LogSkeleton:
     return LogSkeleton(z, pxy, radii, tuple(knots), str(params.get("name", "log")))
 
 
-def read_maps(folder) -> LogSkeleton:
+def read_maps(folder: PathLike) -> LogSkeleton:
     """Read the maps written by :func:`write_maps` (same file names) from ``folder``."""
     from PIL import Image
 

@@ -24,6 +24,7 @@ from numpy.polynomial import chebyshev as C
 from scipy.optimize import least_squares
 
 from ..errors import WoodcamError
+from .._types import ArrayLike
 
 
 def heightmap_axes(length_mm: float, n_l: int, n_theta: int) -> tuple[np.ndarray, np.ndarray]:
@@ -79,7 +80,8 @@ class SurfaceBase:
         return np.einsum("ij,jk,ik->i", T, self.coef, F)
 
 
-def fit_surface_base(radius_mm, l_mm, theta_rad, *, n_fourier: int = 10, n_cheb: int = 10,
+def fit_surface_base(radius_mm: ArrayLike, l_mm: ArrayLike, theta_rad: ArrayLike, *,
+                     n_fourier: int = 10, n_cheb: int = 10,
                      length_mm: float | None = None) -> SurfaceBase:
     """Fit the base shape to a heightmap in the two steps of seed 001 §4.3.
 
@@ -126,7 +128,7 @@ class Thickness:
         return self.a * l[:, 0] + self.b + g @ np.asarray(self.alpha_mm, float)
 
 
-def fit_thickness(l_mm, mean_radius_mm, centres_mm) -> Thickness:
+def fit_thickness(l_mm: ArrayLike, mean_radius_mm: ArrayLike, centres_mm: ArrayLike) -> Thickness:
     """Fit eq. 6 to a mean-radius profile ``(k,)`` given knot-cluster heights ``centres_mm``.
 
     Line by linear least squares, then all parameters by ``scipy.optimize.least_squares``
@@ -248,7 +250,8 @@ def add_surface_knots(radius_mm, l_mm, theta_rad, knots, arc_radius_mm: float) -
     return out
 
 
-def fit_surface_knot(patch_mm, dl_mm, ds_mm, r_l_mm: float, r_s_mm: float) -> SurfaceKnot:
+def fit_surface_knot(patch_mm: ArrayLike, dl_mm: ArrayLike, ds_mm: ArrayLike, r_l_mm: float,
+                     r_s_mm: float) -> SurfaceKnot:
     """Fit ``alpha_l, alpha_s, m, height`` of one bump to a detail patch (seed 001 §4.3).
 
     ``patch_mm : (a, b)`` is the heightmap minus its base around the knot, sampled at offsets

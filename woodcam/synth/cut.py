@@ -129,8 +129,8 @@ def cut_block(log_field: GrowthFieldLike, size_mm: ArrayLike, pattern: SawPatter
     return PlacedField.from_log_frame(log_field, frame)
 
 
-def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm,
-                         ring_width_range_mm=(1.5, 6.0)) -> tuple[AnalyticLogField, dict]:
+def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm: ArrayLike,
+                         ring_width_range_mm: tuple[float, float] = (1.5, 6.0)) -> tuple[AnalyticLogField, dict]:
     """Draw a knot-free eccentric analytic log and a placement (kwargs of :func:`cut_block`).
 
     The ring width at the block centre is log-uniform in ``ring_width_range_mm``; it varies
@@ -161,7 +161,7 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm,
     return log, placement
 
 
-def knot_crosses(field, size_mm, n: int = 12) -> bool:
+def knot_crosses(field: GrowthFieldLike, size_mm: ArrayLike, n: int = 12) -> bool:
     """True when a knot of ``field`` (block frame, with ``knot_features``) crosses the block:
     some point of an ``n^3`` grid over it has knot weight > 0.5 (inside the knot wood)."""
     if not hasattr(field, "knot_features"):

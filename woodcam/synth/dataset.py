@@ -18,10 +18,16 @@ from ..fields.analytic import AnalyticLogField
 from .block import synth_block
 from .cut import PATTERNS, _place_through_knot, cut_block, random_log_placement
 from .degradation import _check_fraction
+from .._types import PathLike
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..fields import KnottedLogField
 
 
-def benchmark_set_block(seed: int, index: int, *, face_px: int = 512, size_range_mm=(30.0, 80.0),
-                        ring_width_range_mm=(1.5, 6.0),
+def benchmark_set_block(seed: int, index: int, *, face_px: int = 512,
+                        size_range_mm: tuple[float, float] = (30.0, 80.0),
+                        ring_width_range_mm: tuple[float, float] = (1.5, 6.0),
                         log_fields: Callable[[np.random.Generator], object] | None = None,
                         knotted_fraction: float = 0.5,
                         wood_factory: Callable[[object], object] | None = None,
@@ -86,8 +92,9 @@ def check_no_stale_blocks(out_dir: Path, count: int, seed: int) -> None:
             f"choose an empty output folder, or delete {str(out_dir)!r} first")
 
 
-def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
-                        size_range_mm=(30.0, 80.0), ring_width_range_mm=(1.5, 6.0),
+def synth_benchmark_set(out_dir: PathLike, count: int, seed: int, *, face_px: int = 512,
+                        size_range_mm: tuple[float, float] = (30.0, 80.0),
+                        ring_width_range_mm: tuple[float, float] = (1.5, 6.0),
                         log_fields: Callable[[np.random.Generator], object] | None = None,
                         knotted_fraction: float = 0.5, wood_factory: Callable[[object], object] | None = None,
                         progress: bool = True, **synth_kwargs) -> list[Path]:
@@ -141,8 +148,8 @@ def synth_benchmark_set(out_dir, count: int, seed: int, *, face_px: int = 512,
     return folders
 
 
-def knotted_log_field(rng: np.random.Generator, ring_width_range_mm=(1.5, 6.0), *,
-                      length_mm: float = 1200.0):
+def knotted_log_field(rng: np.random.Generator, ring_width_range_mm: tuple[float, float] = (1.5, 6.0), *,
+                      length_mm: float = 1200.0) -> KnottedLogField:
     """A knotted log field (log frame) from the log generator of seed 001 (``woodcam.logs``),
     turned into the stem + knot field of seed 003; ring width log-uniform in the range.
     The factory :func:`synth_benchmark_set` takes as ``log_fields``."""

@@ -21,6 +21,11 @@ from .block import synth_block
 from .cut import PATTERNS, cut_block, random_log_placement
 from .dataset import knotted_log_field
 from .photos import _RealisticWood
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..detect.learned import RingNetSpec
+    from ..detect.quilt import QuiltSource
 
 
 FaceStyle = Literal["plain", "realistic"]
@@ -99,7 +104,8 @@ def texture_sources(samples, progress: bool = False) -> list:
     return groups
 
 
-def ring_training_faces(spec, progress: bool = False, sources=None) -> tuple[np.ndarray, np.ndarray]:
+def ring_training_faces(spec: RingNetSpec, progress: bool = False,
+                        sources: Sequence[Sequence[QuiltSource]] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Training data of the learned ring detector for ``spec``
     (:class:`woodcam.detect.learned.RingNetSpec`): ``(inputs (n, h, w) float32, targets (n, h, w)
     float32)`` from ``spec.n_blocks`` synthetic 50 mm cubes, seeds ``[spec.seed, i, 7]`` (never

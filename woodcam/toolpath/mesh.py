@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import WoodcamError
+from .._types import ArrayLike, Mesh
 
 
 def _vertex_grid(heightmap, size_mm):
@@ -160,7 +161,7 @@ def _heightfield_arrays(grid, size_mm, flat_tol_mm):
     return verts, faces, grid_index, runs
 
 
-def heightfield_mesh(heightmap, size_mm, *, flat_tol_mm: float = 1e-9):
+def heightfield_mesh(heightmap: ArrayLike, size_mm: ArrayLike, *, flat_tol_mm: float = 1e-9) -> Mesh:
     """Watertight ``trimesh.Trimesh`` (block frame, mm) of the stock below ``heightmap``.
 
     Parameters

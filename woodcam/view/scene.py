@@ -45,6 +45,10 @@ from .section import (
     plane_basis,
     signed_row_distance,
 )
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pyvista as pv
 
 #: Default sample spacing (mm) of the wood on a cut plane: finer than a 0.5 mm latewood band.
 SECTION_RESOLUTION_MM = 0.25
@@ -276,7 +280,7 @@ def _material_image(material):
     return image
 
 
-def mesh_to_pyvista(mesh):
+def mesh_to_pyvista(mesh: Mesh) -> tuple[pv.PolyData, pv.Texture | None]:
     """Convert a trimesh mesh to pyvista, keeping its texture or colours.
 
     Parameters
@@ -324,7 +328,7 @@ def mesh_to_pyvista(mesh):
     return poly, texture
 
 
-def block_outline(size_mm, *, outset_mm: float = 0.0):
+def block_outline(size_mm: ArrayLike, *, outset_mm: float = 0.0) -> tuple[pv.PolyData, pv.PolyData]:
     """The block ``[0, W] x [0, D] x [0, H]`` as a box surface and its 12 edges, each face moved
     ``outset_mm`` outwards (mm; the preview's :data:`BLOCK_OUTSET`).
 
@@ -359,15 +363,15 @@ def _grid_polydata(pv, origin, u, v, u_range, v_range, n_u: int, n_v: int):
 
 
 def cut_plane_image(
-    wood,
-    size_mm,
-    origin,
-    normal,
+    wood: WoodLike,
+    size_mm: ArrayLike,
+    origin: ArrayLike,
+    normal: ArrayLike,
     resolution_mm: float = SECTION_RESOLUTION_MM,
     *,
     max_samples: int | None = None,
-    part=None,
-):
+    part: Mesh | None = None,
+) -> pv.PolyData:
     """The wood on the part of a plane inside the block, as coloured polydata.
 
     The plane through ``origin`` with unit ``normal`` is sampled on a regular grid of spacing
@@ -740,11 +744,11 @@ class SceneOptions:
 
 
 def build_scene(
-    plotter,
-    mesh_or_path,
+    plotter: pv.Plotter,
+    mesh_or_path: Mesh | PathLike,
     *,
-    wood=None,
-    size_mm=None,
+    wood: WoodLike | None = None,
+    size_mm: ArrayLike | None = None,
     widget: bool = False,
     options: SceneOptions | None = None,
     **scene_options,

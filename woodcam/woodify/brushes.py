@@ -30,6 +30,7 @@ from .._checks import as_floats, check_path, check_vector, did_you_mean, receive
 from .._readers import read_json_file
 from ..errors import WoodcamError
 from ..fields.base import check_points
+from .._types import PathLike
 
 
 @dataclass(frozen=True)
@@ -82,7 +83,7 @@ class Brush:
         return np.exp(-0.5 * d2 / self.radius_mm ** 2)
 
 
-def load_brushes(path) -> list[Brush]:
+def load_brushes(path: PathLike) -> list[Brush]:
     """Read a JSON brush file (module docstring): ``{"brushes": [...]}`` or the list alone."""
     path = check_path(path, "load_brushes: path", fix="pass the brush file, e.g. brushes.json")
     like = ('{"brushes": [{"centre_mm": [x, y, z], "radius_mm": r, "gain": 1.5, "direction": [0, 0, 1], '

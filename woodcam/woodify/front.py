@@ -42,6 +42,8 @@ from ..errors import WoodcamError
 from ..limits import WOODIFY_RESOLUTION_RANGE
 from ..tolerances import WOODIFY_BAND_NODES, WOODIFY_OBSTACLE_CLEARANCE_VOXELS, WOODIFY_ON_SURFACE_VOXELS
 from ..units import say_length
+from collections.abc import Callable, Sequence
+from .._types import ArrayLike, Mesh
 
 Method = Literal["auto", "fmm", "offset", "anisotropic"]
 METHODS: tuple[str, ...] = ("auto", "fmm", "offset", "anisotropic")
@@ -249,8 +251,10 @@ def obstacle_names_of(obstacles, names=None) -> list[str]:
     return names
 
 
-def propagate(mesh, grid: VoxelGrid, *, wind=None, gain=None, obstacles=(), method: Method = "auto",
-              stop_mm: float = np.inf, paint=None, obstacle_names=None) -> Front:
+def propagate(mesh: Mesh, grid: VoxelGrid, *, wind: ArrayLike | None = None, gain: ArrayLike | None = None,
+              obstacles: Sequence[Mesh] = (), method: Method = "auto", stop_mm: float = np.inf,
+              paint: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
+              obstacle_names: Sequence[str] | None = None) -> Front:
     """Arrival time of the front grown from ``mesh`` (see module docstring).
 
     Parameters
@@ -440,7 +444,8 @@ def _fill_obstacle(T, obstacle):
     return out
 
 
-def sphere_arrival(points_mm, centre_mm, radius_mm: float, wind=(0.0, 0.0, 0.0)) -> np.ndarray:
+def sphere_arrival(points_mm: ArrayLike, centre_mm: ArrayLike, radius_mm: float,
+                   wind: ArrayLike = (0.0, 0.0, 0.0)) -> np.ndarray:
     """Exact arrival time (mm) of the front grown from a sphere with normal speed ``1 + w . n``.
 
     The eccentric front at pseudo-time ``T`` is the sphere offset by ``T`` and shifted by

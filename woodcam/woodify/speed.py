@@ -35,7 +35,7 @@ from .._checks import check_vector, real_numbers, received
 from ..errors import WoodcamError
 
 
-def weibull_speed(u, shape: float = 2.0) -> np.ndarray:
+def weibull_speed(u: ArrayLike, shape: float = 2.0) -> np.ndarray:
     """Eq. 4.1: ``s(u) = c u^(c-1) exp(-u^c)`` for ``u >= 0`` (dimensionless time)."""
     u = np.maximum(np.asarray(u, dtype=float), 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -43,13 +43,13 @@ def weibull_speed(u, shape: float = 2.0) -> np.ndarray:
     return np.where(u > 0, s, shape if shape == 1.0 else (np.inf if shape < 1 else 0.0))
 
 
-def weibull_cdf(u, shape: float = 2.0) -> np.ndarray:
+def weibull_cdf(u: ArrayLike, shape: float = 2.0) -> np.ndarray:
     """``W(u) = 1 - exp(-u^c)`` for ``u >= 0``: the integral of eq. 4.1 from 0 to ``u``."""
     u = np.maximum(np.asarray(u, dtype=float), 0.0)
     return -np.expm1(-u ** shape)
 
 
-def weibull_cdf_inv(q, shape: float = 2.0) -> np.ndarray:
+def weibull_cdf_inv(q: ArrayLike, shape: float = 2.0) -> np.ndarray:
     """``W^-1(q) = (-ln(1 - q))^(1/c)`` for ``q`` in [0, 1); ``inf`` for ``q >= 1``."""
     q = np.clip(np.asarray(q, dtype=float), 0.0, 1.0)
     with np.errstate(divide="ignore"):
