@@ -91,6 +91,12 @@ def score_block(seed: int, index: int, methods: tuple[str, ...] | list[str] = ("
                 residual: bool = False) -> dict:
     """Fit benchmark block ``(seed, index)`` with every method and score it on cut planes.
 
+    ``methods``: fitting methods from :data:`woodcam.inference.fit.METHODS`; ``face_set``:
+    ``"full"`` (all six faces) or ``"three"`` (front, top, left: :data:`FACE_SETS`);
+    ``face_px``: the synthetic face photos' side in pixels (default 256); ``pixel_mm``: the
+    cut planes' sample spacing, mm (default :data:`BENCH_PIXEL_MM`, 0.2); ``planes``: the cut
+    planes (default :data:`woodcam.inference.evaluate.DEFAULT_PLANES`).
+
     Returns
     -------
     dict (plain JSON unless ``keep_lines``): ``seed``, ``index``, ``name``, ``kind``

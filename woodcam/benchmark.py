@@ -504,7 +504,10 @@ def bench_report(run_dir: str | Path, out_dir: str | Path, *, gallery: int = 3, 
     blocks of each kind, all regenerated from the seed. The files are one set
     (:func:`woodcam._atomic.all_or_nothing`): an interrupted report leaves the folder's previous
     one as it was; once they are in place, the gallery pictures an earlier report left there
-    (of other blocks) are removed. Returns the summary dict."""
+    (of other blocks) are removed. Returns the summary dict.
+
+    ``run_dir``: the folder ``woodcam bench run`` wrote (its run manifest and ``records/``);
+    ``progress``: a bar on stderr while the gallery's blocks are refitted and drawn."""
     from .scale import read_records, record_path, write_json_atomic
 
     progress = check_bool(progress, "bench_report: progress")

@@ -258,6 +258,8 @@ def unfold_cross(images: dict, size_mm: ArrayLike, background: float | ArrayLike
     """Lay six face images (dict face -> (h, w[, c]) array) out as one unfolded-cross image.
 
     All images must share one pixel density; faces that are absent stay ``background``.
+    ``size_mm``: the block's ``(W, D, H)`` mm, which sets each face's place and extent in the
+    cross (the density is read from the first image's width over its face's width in mm).
     """
     size = check_size(size_mm)
     if not isinstance(images, dict):

@@ -41,6 +41,21 @@ class PartPreview:
         the list of them, ``woodcam.cli.options.remove_stale_outputs``)
     timings_s : dict stage -> seconds
     warnings : list of str
+    meta_block : str
+        The block spec the part was previewed in, set by a caller that knows it (the demo's
+        table); ``""`` otherwise.
+    tessellation : dict
+        :func:`preview_part`: what :func:`woodcam.cad.load_part` put in its ``report``
+        (tolerances used, triangle count and budget, ``simplified``, ``notes``); empty for
+        :func:`preview_mesh`.
+    atlas : str
+        One line on the baked texture atlas (:meth:`woodcam.bake.BakeResult.summary`: size, UV
+        fill, texels/mm, GPU memory).
+    report : dict
+        With ``part_report``: :func:`woodcam.advise.part_report` of the part in its block
+        (volume, yield, knots, pith, end grain, warnings); empty otherwise.
+    texture, charts : see the comment on them below (height-field previews only).
+    stages : the progress bar each :meth:`stage` advances, or None (no bar).
     """
 
     __repr__ = summary_repr  # arrays as shapes: a notebook shows one line

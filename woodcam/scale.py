@@ -81,7 +81,13 @@ _THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "B
 class RunSummary:
     """What :func:`run_many` did: counts of keys and the wall time (s) of this call;
     ``first_failure`` is ``"KEY failed: ERROR"`` of the first key that failed in it ('' if none);
-    ``unit`` what one key is, singular ("block", "shard"), for :meth:`line`."""
+    ``unit`` what one key is, singular ("block", "shard"), for :meth:`line`.
+
+    ``out_dir``: the run folder (records under its ``records/``); ``engine``: ``"local"`` or
+    ``"dask"``; ``workers``: the processes (local) or the cluster's workers (dask) that ran the
+    keys, 0 when none was left to compute; ``total``: the keys asked for, of which ``skipped``
+    had a record already (earlier runs), ``done`` were computed now and ``failed`` raised;
+    ``wall_s``: seconds this call took to compute them (``time.perf_counter``)."""
 
     __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
 
@@ -175,7 +181,8 @@ def record_path(out_dir, key: str) -> Path:
 
 
 def read_records(out_dir: str | Path) -> dict[str, dict]:
-    """Every record of a run folder: ``key -> record`` (see the module docstring), sorted by key.
+    """Every record of the run folder ``out_dir`` (the one given to :func:`run_many`; its
+    ``records/``): ``key -> record`` (see the module docstring), sorted by key.
 
     Temp files left by a killed run start with a dot and are not records.
     """

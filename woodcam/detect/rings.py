@@ -196,6 +196,11 @@ class RingDetection:
     :mod:`woodcam.frames`): ``ring_map`` float32 in [0, 1], ``normal_rad`` the ring normal's
     angle (radians), ``wavelength_px`` the ring spacing (pixels), ``confidence`` in [0, 1],
     ``evidence`` bool; ``traces`` polylines in continuous pixel coordinates ``(row, col)``.
+    ``rule``: the boundary rule the traces were snapped to (one of :data:`BOUNDARY_RULES`,
+    :func:`detect_rings`' ``rule``); ``warnings``: strings naming the face when little or no
+    ring evidence was found. ``order_map`` ``(h, w)`` float32 (rings, NaN outside the evidence)
+    and ``ring_order`` (one number per trace) order the rings across the face, as commented
+    below.
     """
 
     __repr__ = summary_repr  # arrays as shapes: a notebook shows one line

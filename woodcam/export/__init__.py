@@ -474,6 +474,8 @@ def load_textured(path: PathLike) -> Mesh:
     glTF/GLB whose part spans under 1 unit: read as metres with +Y up, as glTF specifies, and
     returned in mm, Z up, with a WoodcamWarning (:func:`woodcam.frames.foreign_gltf_in_block_frame`).
 
+    ``path``: the .glb or .obj file (an OBJ's .mtl and texture read from beside it).
+
     Vertices are not merged (``process=False``), so the vertex count is the exported one.
 
     Raises
@@ -532,7 +534,8 @@ def load_textured(path: PathLike) -> Mesh:
 
 def written_by_woodcam(path: PathLike) -> bool:
     """True for a GLB or OBJ written by :func:`export_glb` / :func:`export_obj` (then
-    :func:`load_textured` returns it in the block frame); False for any other file."""
+    :func:`load_textured` returns it in the block frame); False for any other file.
+    ``path``: the .glb or .obj file (any other suffix: False)."""
     path = check_path(path, "written_by_woodcam: path", fix="a .glb file")
     suffix = path.suffix.lower()
     try:
@@ -573,7 +576,8 @@ def glb_json(data: bytes, where: str) -> dict:
 
 
 def read_glb_metadata(path: PathLike) -> dict:
-    """Return the ``woodcam`` metadata stored by :func:`export_glb` (``{}`` if none).
+    """Return the ``woodcam`` metadata stored by :func:`export_glb` (``{}`` if none) of the
+    GLB file ``path``.
 
     Parses the GLB header and JSON chunk directly (glTF 2.0 spec, "GLB File Format").
     """

@@ -76,6 +76,10 @@ class GridField:
     spacing_mm : float or (3,) float
         Node spacing along X, Y, Z.
     interpolation : "cubic" or "linear"
+    axis : (3,) float, non-zero
+        The pith direction (block frame; default ``(0, 0, 1)``): the fibre direction
+        :func:`woodcam.fields.base.grain_direction` gives everywhere in the field (kept as given;
+        it normalises it).
     layers : dict name -> (nx, ny, nz) float, optional
         Further quantities on the same nodes, read by linear interpolation:
         ``"uncertainty"`` (years; how unsure a fit is of the growth time there, e.g. the spread

@@ -230,6 +230,9 @@ class KnottedLogField:
         Box filter (rows = pith samples, columns = azimuth samples) applied to the measured
         radii before they set the growth speed, as the seed's map maker does (11 x 5), so
         local bumps of the bark do not imprint on every ring.
+    table_samples : int >= 2
+        Radii (from the pith to past the outermost knot end or the bark) at which each knot's
+        axis is tabulated for the lookup (default 128; spacing ``r_top / (table_samples - 1)``).
     chunk : int or None
         numpy backend: points per height-sorted chunk (default 2048); it holds about
         ``chunk x knots-per-chunk x 40`` floats.

@@ -309,6 +309,9 @@ def benchmark(blocks: Sequence[Block], methods: Sequence[str] = ("rbf", "radial"
     blocks : list of Block, each with a ``true_field``
     methods : fitting methods (see :data:`woodcam.inference.fit.METHODS`)
     face_sets : dict label -> list of faces or None (all); default ``{"full": None}``
+    planes : cut planes to score on (:class:`CutPlane`, points as fractions of the block
+        size; default :data:`DEFAULT_PLANES`)
+    pixel_mm : sample spacing on each plane, mm (default 0.1, :data:`woodcam.tolerances.EVAL_PIXEL_MM`)
     out_dir : folder for ``table.md`` and one PNG per block and face set (predicted vs true
         ring lines on every plane); nothing is written when None.
     progress : optional callable taking one line of text per fit.

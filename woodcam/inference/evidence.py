@@ -694,6 +694,8 @@ def fit_evidence(obs: RingObservations, size_mm: ArrayLike, n_basins: int = 3,
     size_mm : (3,) block size
     n_basins : pith-axis basins of the radial fit to try as hypotheses
     candidates : hypothesis families, from :data:`CANDIDATES`
+    seed : int >= 0 (default 0) of the radial pith search, the stem recipe's start search and
+        the held-out folds: the same seed gives the same fit
     extra : further hypotheses to judge with the others (e.g. a planted one in a test)
     recipes : further hypotheses as recipes, name -> ``RingObservations -> field``, fitted on
         the same rings as the others (the given years, else the radial numbering; e.g. the stem

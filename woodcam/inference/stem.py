@@ -335,6 +335,10 @@ def fit_stem(obs: RingObservations, size_mm: ArrayLike, base_axes: ArrayLike | N
     n_search, n_fit : points used for the start search and the refinement (fixed random subsets)
     n_starts : starts refined at low order per base axis
     n_final : of those, the cheapest finished at full order
+    seed : int >= 0 (default 0) of the random point subsets and starts: the same seed, the
+        same fit
+    history : fit the growth-history warp ``h`` (year-to-year ring width, module docstring;
+        default True); False leaves it the identity (``history_levels`` None)
     offset_years : (n,) years per observation the stem does not explain (e.g. the bend a knot
         puts into the rings round it: :func:`woodcam.inference.knots.fit_knotted_stem`): the stem
         is fitted to ``obs.years - offset_years``; default none

@@ -59,7 +59,7 @@ def write_log(log: LogSkeleton, path: PathLike) -> Path:
 
 def read_log(path: PathLike) -> LogSkeleton:
     """Read a woodcam log file written by :func:`write_log` (or by hand, same keys) as a
-    :class:`~woodcam.fields.skeleton.LogSkeleton` (log frame, mm)."""
+    :class:`~woodcam.fields.skeleton.LogSkeleton` (log frame, mm). ``path``: the JSON log file."""
     path = check_path(path, "read_log: path", fix="a JSON log file written by write_log")
     if not path.is_file():
         raise WoodcamError(f"log file {str(path)!r} does not exist; give a path to a JSON file "

@@ -130,7 +130,9 @@ class Parquetry:
 class ParquetryRun:
     """Everything a run made: the targets' panels, the sheets, the bank (consumed wood), timing.
 
-    ``placed`` / ``planned``: patches placed of those planned; ``match_seconds`` (wall clock)
+    ``placed`` / ``planned``: patches placed of those planned; ``message``: why a run stopped
+    short ("the veneers ran out of free wood: ..." with a fix), ``""`` for a complete one;
+    ``match_seconds`` (wall clock)
     and ``cpu_seconds``, s; ``repaired``: piece (patch) id -> what :func:`repair_fabricability`
     changed. Panel images and patch windows are in panel pixels at ``params.px_per_mm``
     (:class:`Patch`), veneers in their own pixels (:class:`Veneer`).
@@ -548,7 +550,9 @@ def repair_fabricability(run: ParquetryRun, max_rounds: int = 4) -> dict[int, st
     window it crosses, so the wood under it was matched and is consumed already (single use
     is unchanged); labels, render and baseline are redone. Returns ``{piece id: what was
     done}`` (also merged into ``run.repaired``); the files written afterwards are checked again
-    by :func:`write_parquetry`.
+    by :func:`write_parquetry`. ``max_rounds`` (default 4): check-and-straighten rounds per
+    panel; a panel's pieces are checked again after each round (its neighbours' outlines
+    change too) until none fails or the rounds are spent.
     """
     from .cutpaths import check_piece, panel_outlines
     from .seams import labels_from_lines, straight_line

@@ -71,6 +71,8 @@ class ParquetryParams:
         chooses the smallest of 4, 8, 16 whose coarse search holds at most
         ``AUTO_COARSE_PX`` pixels (the four 600 x 400 mm sheets at 4 px/mm of the issue's
         workload get 16)
+    single_use : every piece of veneer is cut once (the paper's constraint; default True);
+        False gives the unconstrained matcher, wood reused, an upper bound of the quality
     w_struct : weight of the structural term (SSIM's contrast-structure, 7 x 7 windows of the
         target image's own pixels, the wood area-averaged to them) that re-ranks the ``rerank``
         cheapest distinct free candidates of eq. 4 (woodcam's addition; 0: eq. 4 alone).
@@ -357,6 +359,10 @@ class ParquetryJob:
         veneers sliced from woodcam blocks / logs (woodcam's extension)
     mokume : Mokume sample folders used as veneers (their face photos)
     targets : ``[{"filename", "scale", "dpi"}]``
+    params : :class:`ParquetryParams`, the run's knobs (default: all their defaults)
+    units_said : the job file said its lengths are mm (``"units"`` under ``"woodcam"``, as
+        :func:`write_job` writes it), so ``--units inch`` leaves its lengths alone (as commented
+        below)
     """
 
     __repr__ = summary_repr  # arrays as shapes: a notebook shows one line
@@ -402,7 +408,8 @@ class JobPathError(WoodcamError):
 
 
 def read_job(path: str | Path) -> ParquetryJob:
-    """Read a job file (paper layout + ``"woodcam"`` extras); paths resolved against its folder."""
+    """Read a job file (paper layout + ``"woodcam"`` extras); paths resolved against its folder.
+    ``path``: the job's JSON file."""
     from .._readers import read_json_object
 
     p = check_path(path, "read_job: path", fix="a parquetry job file (JSON)")
@@ -503,7 +510,8 @@ def read_job(path: str | Path) -> ParquetryJob:
 def write_job(job: ParquetryJob, path: str | Path) -> Path:
     """Write a job file in the paper's layout (woodcam-only keys under ``"woodcam"``), atomically.
     Its paths are written absolute: the job's are relative to the working folder (as given on
-    the command line), a job file's to its own folder."""
+    the command line), a job file's to its own folder. ``path``: the JSON file to write
+    (e.g. ``job.json``); returns it."""
     from .._atomic import write_text
 
     if not isinstance(job, ParquetryJob):  # None was an AttributeError ('params')

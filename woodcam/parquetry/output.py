@@ -152,7 +152,8 @@ def write_parquetry(run: ParquetryRun, out_dir: str | Path, *,
     time, a ``job.json`` without ``job``) are removed, with a WoodcamWarning naming them; the
     run lists its files in ``.woodcam-parquetry-files.json`` for the next
     (:func:`woodcam._atomic.remove_stale`). In ``result.json`` a sheet no piece is cut from
-    has ``file_svg`` null.
+    has ``file_svg`` null. ``progress``: a bar on stderr while the sheets' cut files are
+    written (more than one sheet; off by default).
     """
     import base64
     import io

@@ -268,7 +268,8 @@ def mokume_veneers(folder: str | Path, size_mm: float = 50.0) -> list[Veneer]:
     in any case (``A_COL.PNG``; :func:`woodcam.block.io.mokume_files`, the one reader of a
     Mokume sample's names: only lower-case ones were found here).
 
-    The cubes are ``size_mm`` on a side (the dataset does not store it; woodcam's Mokume
+    ``folder``: the sample's folder (e.g. ``shared/data/mokume/H11``). The cubes are ``size_mm``
+    on a side (the dataset does not store it; woodcam's Mokume
     default is 50 mm), so a 256 px photo is ``256 / size_mm`` px/mm.
     """
     folder = check_path(folder, "mokume_veneers: folder", fix="a Mokume sample folder such as shared/data/mokume/H11")
@@ -318,6 +319,9 @@ def slice_veneers(stock: StockLike, n_sheets: int, size_mm: tuple[float, float],
     px_per_mm : sheet resolution
     axis : "x", "y" or "z": the normal of the slicing planes
     start_mm : first plane along ``axis`` (default: the middle of the block)
+    id_prefix : leaf ``k``'s id is ``f"{id_prefix}-{k:02d}"``; default the stock's spec with
+        ``:``, ``/`` and ``\\`` made ``-`` (``builtin:flat-sawn``: ``builtin-flat-sawn-00``, ...)
+    progress : a bar on stderr, one step per sheet (off by default)
     supersample : each pixel is the mean of ``supersample x supersample`` point samples of
         ``Wood.color`` over its square, as a scanner integrates over its pixel. One sample per
         pixel aliases the 0.1-0.3 mm latewood lines into stair-steps at 4 px/mm, which adds

@@ -84,6 +84,11 @@ class Program:
     G20/G21 the program used; ``kind (n,)`` (0 rapid, 1 feed), ``tool (n,)``, ``line (n,)``
     (1-based source line), ``feed_mm_min (n,)`` mm/min, ``spindle_rpm (n,)``; ``inch (n,)``
     bool and ``ran_line (n,)`` int per move as commented below.
+
+    ``source``: where the program came from (the file name, ``"<string>"`` for text);
+    ``tool_numbers``: the distinct tool numbers its moves use, sorted; ``warnings``,
+    ``messages`` (its ``(MSG,...)`` / ``(DEBUG,...)`` operator messages) and ``printed`` (its
+    ``(PRINT,...)`` texts): lists of ``"line N: ..."`` strings (module docstring).
     """
 
     __repr__ = summary_repr  # arrays as shapes: a notebook shows one line

@@ -146,7 +146,9 @@ class SimResult:
     ``heightmap (ny, nx)`` float: top of the remaining stock over each cell centre, block-frame
     Z in mm (row ``j`` along +Y, column ``i`` along +X); ``size_mm (3,)`` the stock's W, D, H
     mm; ``cell_mm (2,)`` the cell size ``(dx, dy)`` mm; ``report``: the issues found (rapids
-    into stock, ...); ``stats``: counts and timings.
+    into stock, ...); ``stats``: counts and timings; ``line_map (ny, nx)`` int: the source
+    line that cut each cell last (0: not cut), with ``simulate(..., track_lines=True)``, else
+    None.
     """
 
     __repr__ = summary_repr  # arrays as shapes: a notebook shows one line

@@ -524,7 +524,8 @@ def parse_tool_spec(spec: str) -> Tool:
 
 def load_tool_table(path: PathLike) -> dict[int, Tool]:
     """Read a TOML tool table (module docstring; lengths in mm), or a CAMotics JSON tool table
-    (:func:`load_camotics_tools`, converted from its units), into ``{tool number: Tool}``."""
+    (:func:`load_camotics_tools`, converted from its units), into ``{tool number: Tool}``.
+    ``path``: a ``.toml`` file, or a ``.json`` / ``.camotics`` file read as CAMotics' table."""
     path = check_path(path, "load_tool_table: path", fix="a TOML or CAMotics JSON tool table")
     if path.suffix.lower() in (".json", ".camotics"):
         return load_camotics_tools(path)
