@@ -199,7 +199,8 @@ SPECIES: dict[str, Species] = {**_LEGACY, **_CITED}
 
 
 def get_species(species: Species | str) -> Species:
-    """Return a :class:`Species` from a preset name or a Species."""
+    """Return a :class:`Species` from a preset name or a Species: ``species`` is a key of
+    :data:`SPECIES` (``"oak"``, ``"walnut"``, ...) or a :class:`Species`, returned as it is."""
     if isinstance(species, Species):
         return species
     # a list or dict asked with `in` raised a bare TypeError (unhashable)

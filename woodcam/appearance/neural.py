@@ -189,7 +189,7 @@ def fit_neural_appearance(block: Block, field: GrowthFieldLike | None = None, *,
                           resolution: int = 128, quality: Quality = "normal",
                           epochs: int | None = None, seed: int = 0,
                           orientation: Orientation = "dependent", source: Source = "auto",
-                          cache_dir: PathLike | None = None, progress: bool = True,
+                          cache_dir: PathLike | Literal[False] | None = None, progress: bool = True,
                           threads: int | None = 1, detail: bool = True) -> NeuralAppearance:
     """Learn a block's appearance from its photos and build its colour volumes (cached).
 
@@ -214,6 +214,11 @@ def fit_neural_appearance(block: Block, field: GrowthFieldLike | None = None, *,
         a photo face lacks a ring map, else "ring_map".
     cache_dir : folder for the cached volumes and weights, default :func:`default_cache_dir`;
         ``False`` disables the cache.
+    progress : bool
+        tqdm bars on stderr over the networks' training steps (default True).
+    threads : int or None
+        ``torch.set_num_threads`` while training (None leaves torch's setting; default 1,
+        :func:`~.translation.train_translation`).
     detail : bool
         Store the networks' ring input and the local slope of colour over it with the volumes
         (:func:`~.volumes.guide_slopes`), so that lookups add the detail of the field's exact
@@ -350,7 +355,10 @@ def block_appearance(block: Block, field: GrowthFieldLike, kind: AppearanceKind 
     ``kind="neural"`` on a block without photos falls back to the species colour map and says
     so with an :class:`AppearanceFallbackWarning`, naming the training settings in
     ``neural_params`` it then ignores (``quality``, ``epochs`` ...: they were taken without a
-    word). ``neural_params`` go to :func:`fit_neural_appearance`.
+    word). ``neural_params`` go to :func:`fit_neural_appearance`. ``field``: the block's growth
+    field, ``(n, 3) mm (block frame) -> (n,) years``, that the colour map is fitted along
+    (:meth:`ColorMapAppearance.fit_to_block`) or the networks read; ``species``: the colour
+    map's species (the fallback's too; a fitted neural appearance does not use it).
     """
     if kind not in APPEARANCE_KINDS:
         raise WoodcamError(f"appearance must be one of {', '.join(APPEARANCE_KINDS)}; got {kind!r}")

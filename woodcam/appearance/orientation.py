@@ -43,7 +43,8 @@ def axis_weights(normals: ArrayLike) -> np.ndarray:
 
     Column ``k`` weighs the colouring seen on a plane whose normal is block axis ``k``
     (column 0 = ``RGB_YZ``, 1 = ``RGB_ZX``, 2 = ``RGB_XY``); rows sum to 1. A zero normal
-    (degenerate triangle) gets equal weights rather than a division by zero.
+    (degenerate triangle) gets equal weights rather than a division by zero. ``normals``:
+    ``(n, 3)`` surface normals (block frame; need not be unit length).
     """
     n = np.ascontiguousarray(normals, dtype=np.float32)
     if n.ndim != 2 or n.shape[1] != 3:
@@ -54,6 +55,8 @@ def axis_weights(normals: ArrayLike) -> np.ndarray:
 
 
 def blend_axis_colors(rgb_yz: ArrayLike, rgb_zx: ArrayLike, rgb_xy: ArrayLike, normals: ArrayLike) -> np.ndarray:
-    """Eq. 10: blend three ``(n, 3)`` colourings by the surface ``normals : (n, 3)``."""
+    """Eq. 10: blend three ``(n, 3)`` colourings by the surface ``normals : (n, 3)`` (block
+    frame): ``rgb_yz``, ``rgb_zx``, ``rgb_xy`` as seen on the planes normal to X, Y and Z,
+    weighted by :func:`axis_weights`."""
     w = axis_weights(normals)
     return w[:, 0:1] * rgb_yz + w[:, 1:2] * rgb_zx + w[:, 2:3] * rgb_xy

@@ -49,7 +49,11 @@ class RidgeScore:
 
 def ridge_scores(detected_px: np.ndarray, reference_px: np.ndarray,
                  thresholds: Sequence[float] = SCORE_THRESHOLDS_PX) -> RidgeScore:
-    """Score detected points ``(n, 2)`` against reference ridge pixels ``(k, 2)`` (module docstring)."""
+    """Score detected points ``(n, 2)`` against reference ridge pixels ``(k, 2)`` (module docstring).
+
+    ``detected_px``, ``reference_px``: ``(row, col)`` pixel coordinates of one face image;
+    ``thresholds``: the distances (px) a point may lie from the other set and still count
+    (default :data:`SCORE_THRESHOLDS_PX`, 2 and 5 px), one precision / recall / F1 each."""
     from scipy.spatial import cKDTree
 
     det = np.asarray(detected_px, float).reshape(-1, 2)

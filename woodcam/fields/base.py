@@ -36,7 +36,8 @@ def check_points(points_mm: ArrayLike, name: str = "points_mm", *, frame: str = 
     """Return ``points_mm`` as a float64 ``(n, 3)`` array of finite points within
     :data:`~woodcam.tolerances.POINT_BOUND_MM` of the origin, or raise a clear error.
 
-    ``frame`` names the frame the caller's points are in (``"block"``, or ``"log"`` for a
+    ``name`` is what the errors call the points (default ``"points_mm"``); ``frame`` names the
+    frame the caller's points are in (``"block"``, or ``"log"`` for a
     log-frame field called directly), for the bound's fix: a log field was told to pass
     block-frame points."""
     p = as_floats(points_mm)

@@ -600,7 +600,8 @@ from .placement import PlacedField, place_block_in_log  # noqa: E402,F401  (re-e
 def block_at_knot(log: LogSkeleton, knot_index: int, size_mm: ArrayLike, *,
                   front_r_mm: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Placement ``(origin_mm, rotation)`` of a ``W x D x H`` block whose front face (Y = 0)
-    is a tangential face of ``log`` cut through knot ``knot_index``.
+    is a tangential face of ``log`` cut through knot ``knot_index``; ``size_mm`` is that
+    ``(W, D, H)`` in mm.
 
     The block's Z runs along the log, its Y points from the front face toward the pith, its X
     is tangential; the front face lies ``front_r_mm`` from the pith (default: where the knot

@@ -137,5 +137,7 @@ class PlacedField:
 def place_block_in_log(log_field: GrowthFieldLike, origin_mm: ArrayLike,
                        rotation: ArrayLike | None = None) -> PlacedField:
     """Place a block in a log: block point ``p`` sits at ``origin_mm + rotation @ p`` (log
-    frame, mm). See :class:`PlacedField`."""
+    frame, mm). ``log_field``: the log's growth field, called with log-frame points
+    (``(n, 3) mm -> (n,) years``); ``rotation``: ``(3, 3)``, default the identity. See
+    :class:`PlacedField`."""
     return PlacedField(log_field, origin_mm, rotation)

@@ -327,7 +327,11 @@ class LogSkeleton:
 def simple_log(length_mm: float = 600.0, radius_mm: float = 100.0, knots: Sequence[BranchStrand] = (), *,
                z_step_mm: float = 10.0, azimuths: int = 36, name: str = "simple") -> LogSkeleton:
     """A straight cylindrical log (pith on the ``z`` axis, constant radius) with ``knots``:
-    the analytic test case and a starting point for hand-made logs."""
+    the analytic test case and a starting point for hand-made logs.
+
+    ``length_mm`` (> 0) long from ``z = 0``, sampled every ``z_step_mm`` along the pith;
+    ``radius_mm`` (> 0) at each of ``azimuths`` directions round it (log frame, mm);
+    ``knots``: a sequence of :class:`BranchStrand` (none by default); ``name``: the log's name."""
     if not (length_mm > 0 and radius_mm > 0):
         raise WoodcamError(f"length_mm and radius_mm must be > 0; got {length_mm}, {radius_mm}")
     z = np.arange(0.0, length_mm + 0.5 * z_step_mm, z_step_mm)

@@ -269,6 +269,11 @@ def evaluate_fits(true_field: GrowthFieldLike, fitted: dict[str, GrowthFieldLike
                   keep_lines: bool = False) -> dict[str, tuple[dict, list[PlaneScore]]]:
     """:func:`evaluate_fit` for several fields (dict name -> field) sharing the true lines.
 
+    ``true_field`` and each field of ``fitted``: ``(n, 3) mm (block frame) -> (n,) years``;
+    ``size_mm``: the block's ``(W, D, H)`` mm; ``planes``: the cut planes (default
+    :data:`DEFAULT_PLANES`), sampled every ``pixel_mm`` mm (default 0.1); ``keep_lines``: keep
+    each plane's ring lines in its :class:`PlaneScore` (for :func:`plot_planes`).
+
     Returns dict name -> ``(summary, scores)``.
     """
     # pixel_mm=0 or NaN was np.arange's ValueError, a plane that is not a CutPlane an AttributeError

@@ -154,7 +154,9 @@ class FaceScore:
 
 def score_face(field: GrowthFieldLike, block: Block, face: str,
                thresholds: Sequence[float] = HOLDOUT_THRESHOLDS_PX) -> FaceScore:
-    """Score ``field``'s ring lines on ``face`` of ``block`` against that face's ring map."""
+    """Score ``field``'s ring lines on ``face`` of ``block`` against that face's ring map;
+    ``thresholds``: the distances (px of the face image) a line may lie from the map's ridges
+    and still count (default :data:`~woodcam.tolerances.HOLDOUT_THRESHOLDS_PX`, 1, 2 and 5 px)."""
     excl, ridge = _face_reference(block, face)
     f = block.faces[face]
     return _score(face, face_years(field, face, f.shape, block.size_mm), ridge, excl, thresholds)

@@ -829,8 +829,9 @@ def _relabel(obs: RingObservations, field: RadialField) -> tuple[RingObservation
 
 
 def number_observations(obs: RingObservations, field: GrowthFieldLike) -> RingObservations:
-    """Label every ring group with the integer nearest ``field``'s median growth time on it
-    (e.g. to hand unlabelled ring maps to a method that needs years, numbered by a radial fit)."""
+    """Label every ring group of ``obs`` (block frame, mm) with the integer nearest ``field``'s
+    median growth time on it (e.g. to hand unlabelled ring maps to a method that needs years,
+    numbered by a radial fit)."""
     years = np.round(_group_medians(field(obs.points_mm), obs.group, obs.n_groups))
     return RingObservations(obs.points_mm, years[obs.group], obs.group, obs.face)
 
@@ -847,6 +848,16 @@ def fit_radial(obs: RingObservations, size_mm: ArrayLike, K: int = 12, M: int = 
     chosen so the pith sits at year ~0 (exact for fields of the eq. 7-9 family, otherwise the
     rings are right "up to the age offset").
 
+    obs : ring observations of the block (block frame, mm), labelled with years or not
+    size_mm : (3,) block size, mm
+    K, M : Fourier order in azimuth and polynomial order along the axis of the speed ``s``
+        (:class:`~woodcam.fields.radial.RadialField`; default 12 and 1)
+    ridge : weight of the ridge penalty on the coefficients (higher harmonics cost more;
+        default 1e-8, scaled by the number of points and the median pith distance)
+    max_relabel_rounds : rounds of renumbering the traces that misfit by over half a year and
+        refitting (default 2)
+    seed : the random point subsets and starts of the axis search (default 0): the same seed,
+        the same fit
     history : also fit the tree's growth history, a monotone warp of the years that gives every
         year its own ring width (:func:`_fit_growth_history`); False keeps the plain model.
     """

@@ -85,6 +85,11 @@ def fit_face_residual(obs: RingObservations, base: Callable, size_mm: ArrayLike,
         ``max_points`` of them (a fixed random subset) are used.
     base : the smooth field, ``(n, 3) mm -> (n,) years``.
     size_mm : (3,) block size.
+    spacing_mm : knot spacing (mm) of each face's residual B-spline (default
+        :data:`~woodcam.tolerances.RESIDUAL_SPACING_MM`, 3 mm).
+    depth_mm : depth (mm) of the residual's fall-off ``exp(-(d / depth_mm)^2)`` from its face
+        (default :data:`~woodcam.tolerances.RESIDUAL_DEPTH_MM`, 5 mm).
+    seed : the random subset of ``max_points`` (default 0).
 
     Minimises ``sum_i w_i huber(r(p_i) - res_i) + c^T P c`` over every face's coefficients
     ``c``: ``w_i`` makes each face's points weigh one per knot cell in all, ``P`` the P-spline

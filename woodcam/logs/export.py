@@ -114,9 +114,11 @@ def export_log_glb(log: GeneratedLog, path: PathLike, *, surface_alpha: float = 
                    max_cols: int = 180) -> Path:
     """Write ``log`` as a binary glTF: the surface mesh (node ``surface``) and the knots (``knots``).
 
-    ``surface_alpha`` < 1 makes the surface translucent (alpha blending) so the knots show.
-    Vertices in mm under a root node that makes them metres, +Y up (module docstring). Returns
-    the path written.
+    ``path``: the ``.glb`` file to write. ``surface_alpha`` < 1 makes the surface translucent
+    (alpha blending) so the knots show. ``max_rows`` x ``max_cols``: the most heightmap rows
+    (along the log) and columns (round it) the surface mesh keeps (:func:`surface_mesh`
+    subsamples to them; default 400 x 180). Vertices in mm under a root node that makes them
+    metres, +Y up (module docstring). Returns the path written.
     """
     if not (0.0 < surface_alpha <= 1.0):
         raise WoodcamError(f"surface_alpha must lie in (0, 1]; got {surface_alpha!r}")
@@ -168,7 +170,9 @@ def heightmap_image(log: GeneratedLog,
 
 
 def heightmap_png(log: GeneratedLog, path: PathLike, *, mode: Literal["height", "detail"] = "height") -> Path:
-    """Write the heightmap (:func:`heightmap_image`) as a 16-bit grey PNG.
+    """Write the heightmap of ``log`` (:func:`heightmap_image` in ``mode``: ``"height"``, the
+    full radius, or ``"detail"``, radius minus the smooth base) as a 16-bit grey PNG at
+    ``path`` (``.png``).
 
     Grey 0 and 65535 are the range's ends, stored in mm in the PNG text chunk
     ``woodcam:range_mm`` (``"lo hi"``) so the file decodes back to millimetres.
@@ -187,7 +191,8 @@ def heightmap_png(log: GeneratedLog, path: PathLike, *, mode: Literal["height", 
 
 
 def read_heightmap_png(path: PathLike) -> np.ndarray:
-    """Decode a PNG written by :func:`heightmap_png` back to mm, ``(n_l, n_theta)``, row 0 = ``l = 0``."""
+    """Decode the PNG ``path`` written by :func:`heightmap_png` back to mm, ``(n_l, n_theta)``,
+    row 0 = ``l = 0``."""
     from PIL import Image
 
     with Image.open(path) as im:

@@ -246,7 +246,9 @@ def fit_gran_knots(knots_json: PathLike, *, indices: ArrayLike | None = None, n_
                    n_around: int = 12) -> GranFitTable:
     """Fit the knot model to the knots of a ``Gran_*_knots.json`` log (see module docstring).
 
-    ``indices`` selects rows (default all). Each knot's sampled points are fitted independently.
+    ``knots_json``: the ``Gran_*_knots.json`` file (rows of 9 numbers). ``indices`` selects rows
+    (default all). Each knot's sampled points (``n_along`` x ``n_around`` on its surface,
+    :func:`sample_gran_knot_points`) are fitted independently.
     """
     data = _load_gran_knots(knots_json)
     idx = np.arange(len(data)) if indices is None else np.asarray(indices, dtype=int)

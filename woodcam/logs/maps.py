@@ -114,8 +114,8 @@ def encode_maps(log: LogSkeleton, *, stem_shape=(512, 128), knot_columns: int = 
 
 
 def write_maps(log: LogSkeleton, folder: PathLike, **kw) -> dict:
-    """Write the maps of :func:`encode_maps` as PNGs plus ``map_params.json`` into ``folder``;
-    returns ``{name: path}``."""
+    """Write the maps of :func:`encode_maps` of ``log`` as PNGs plus ``map_params.json`` into
+    ``folder`` (made if missing); ``kw`` go to :func:`encode_maps`. Returns ``{name: path}``."""
     from PIL import Image
 
     folder = Path(folder)

@@ -88,6 +88,10 @@ def fit_surface_base(radius_mm: ArrayLike, l_mm: ArrayLike, theta_rad: ArrayLike
     Each row ``radius_mm[i, :]`` is least-squares fitted with ``n_fourier`` Fourier terms, then
     each coefficient's curve along ``l`` with ``n_cheb`` Chebyshev terms. Both steps are linear,
     so a heightmap made by a :class:`SurfaceBase` of the same sizes is recovered exactly.
+
+    ``radius_mm`` is ``(n_l, n_theta)`` mm, sampled at heights ``l_mm (n_l,)`` along the log
+    and azimuths ``theta_rad (n_theta,)``; ``length_mm``: the log's length the Chebyshev
+    variable spans (default ``max(l_mm)``).
     """
     h = np.asarray(radius_mm, dtype=float)
     l = np.asarray(l_mm, dtype=float).reshape(-1)
@@ -129,7 +133,8 @@ class Thickness:
 
 
 def fit_thickness(l_mm: ArrayLike, mean_radius_mm: ArrayLike, centres_mm: ArrayLike) -> Thickness:
-    """Fit eq. 6 to a mean-radius profile ``(k,)`` given knot-cluster heights ``centres_mm``.
+    """Fit eq. 6 to a mean-radius profile ``mean_radius_mm (k,)`` (mm) at heights
+    ``l_mm (k,)`` along the log, given knot-cluster heights ``centres_mm`` (mm).
 
     Line by linear least squares, then all parameters by ``scipy.optimize.least_squares``
     (bulge widths kept in [5, 500] mm, shifts within +-100 mm).
@@ -256,7 +261,9 @@ def fit_surface_knot(patch_mm: ArrayLike, dl_mm: ArrayLike, ds_mm: ArrayLike, r_
 
     ``patch_mm : (a, b)`` is the heightmap minus its base around the knot, sampled at offsets
     ``dl_mm : (a,)`` and ``ds_mm : (b,)`` from the bump centre; the radii come from the internal
-    knot model. Minimises the RMSE with ``scipy.optimize.least_squares`` (bounded).
+    knot model (``r_l_mm``, ``r_s_mm``: the zero-crossing radii along ``l`` and round the
+    circumference, arc mm, as :class:`SurfaceKnot`'s). Minimises the RMSE with
+    ``scipy.optimize.least_squares`` (bounded).
     """
     P = np.asarray(patch_mm, float)
     DL, DS = np.asarray(dl_mm, float)[:, None], np.asarray(ds_mm, float)[None, :]
@@ -287,6 +294,10 @@ def gabor_noise(n_l: int, n_theta: int, dl_mm: float, ds_mm: float, rng: np.rand
     half the wavelength and weight ``0.5^o``. The azimuth is periodic; along ``l`` the noise is
     computed on a padded grid and cropped so the log's two ends do not correlate. The result
     is scaled to standard deviation ``amplitude_mm``.
+
+    ``n_l`` x ``n_theta`` samples ``dl_mm`` apart along the log and ``ds_mm`` (arc mm) round
+    it; ``rng``: the white noise's generator; ``wavelength_mm``: the first octave's wavelength
+    across the grain (default 12 mm).
     """
     pad = n_l // 4 + 8
     nl = n_l + 2 * pad

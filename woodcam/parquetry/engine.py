@@ -613,7 +613,9 @@ def _area(a: np.ndarray, shape: tuple[int, int] | None) -> np.ndarray:
 def feature_cost(p: Parquetry, image: np.ndarray, params: ParquetryParams,
                  grid: MetricGrid = "working") -> float:
     """Eq. 8 per pixel: mean over the panel of ``|F(R) - F(I_T)|^2`` with ``F`` of eq. 1 (the
-    target's intensity histogram-matched, eq. 2). ``image (H, W, 3)`` is a render or baseline.
+    target's intensity histogram-matched, eq. 2). ``image (H, W, 3)`` is a render or baseline
+    of the panel ``p`` (:class:`Parquetry`, panel pixels at ``params.px_per_mm``); ``params``
+    gives eq. 1's weights ``w_intens`` and ``w_edge``.
 
     grid : "working" compares at ``px_per_mm`` with the target's features of the matching;
         "native" area-averages image and target to the target image's own pixels first (the
@@ -635,7 +637,8 @@ def ssim_vs_matched(p: Parquetry, image: np.ndarray, downsample: int = 1,
     structure at half a patch rather than the wood's sub-millimetre grain), or with
     ``grid="native"`` to the target image's own pixels (``downsample`` then unused). None
     where that grid, or the working one, is narrower than the 7 x 7 window (a 4 x 4 px
-    target's own pixels): SSIM has no value there."""
+    target's own pixels): SSIM has no value there. ``p``: the panel (:class:`Parquetry`) whose
+    matched target ``image`` (a render or baseline, ``(H, W, 3)`` panel pixels) is compared to."""
     from skimage.metrics import structural_similarity
 
     a, b = intensity(image), p.matched

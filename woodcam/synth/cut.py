@@ -134,7 +134,9 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm:
     """Draw a knot-free eccentric analytic log and a placement (kwargs of :func:`cut_block`).
 
     The ring width at the block centre is log-uniform in ``ring_width_range_mm``; it varies
-    slowly with radius (``width_slope_per_mm`` within +-0.003 / mm).
+    slowly with radius (``width_slope_per_mm`` within +-0.003 / mm). ``rng``: the generator
+    every draw comes from; ``pattern``: the sawing pattern (one of :data:`PATTERNS`);
+    ``size_mm``: the block's ``(W, D, H)`` mm.
     """
     W, D, _ = check_size(size_mm)
     half_diag = 0.5 * math.hypot(W, D)
@@ -162,8 +164,9 @@ def random_log_placement(rng: np.random.Generator, pattern: SawPattern, size_mm:
 
 
 def knot_crosses(field: GrowthFieldLike, size_mm: ArrayLike, n: int = 12) -> bool:
-    """True when a knot of ``field`` (block frame, with ``knot_features``) crosses the block:
-    some point of an ``n^3`` grid over it has knot weight > 0.5 (inside the knot wood)."""
+    """True when a knot of ``field`` (block frame, with ``knot_features``) crosses the block
+    ``size_mm`` (``(W, D, H)`` mm): some point of an ``n^3`` grid over it has knot weight > 0.5
+    (inside the knot wood)."""
     if not hasattr(field, "knot_features"):
         return False
     size = check_size(size_mm)

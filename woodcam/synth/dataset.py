@@ -36,7 +36,11 @@ def benchmark_set_block(seed: int, index: int, *, face_px: int = 512,
 
     Drawn from ``np.random.default_rng([seed, index])`` only, so it is the same block whichever
     process makes it and whatever else is made. Returns the block and its index entry (name,
-    size, knotted, ring width, placement).
+    size, knotted, ring width, placement). ``face_px``, ``size_range_mm``,
+    ``ring_width_range_mm``, ``log_fields``, ``knotted_fraction``, ``wood_factory`` and
+    ``synth_kwargs`` are :func:`synth_benchmark_set`'s: the face images' pixels along the block's longest side, the
+    (min, max) block side and ring width (mm), the knotted-log factory and the share of knotted
+    blocks, the appearance factory, and further :func:`synth_block` arguments.
     """
     i = int(index)
     rng = np.random.default_rng([int(seed), i])
@@ -107,6 +111,11 @@ def synth_benchmark_set(out_dir: PathLike, count: int, seed: int, *, face_px: in
 
     Parameters
     ----------
+    face_px : int
+        Pixels of the face photos and ring maps along the block's longest side (their
+        ``px_per_mm`` is ``face_px / max(size)``; default 512).
+    progress : bool
+        A bar on stderr, one step per block (default True).
     log_fields : callable ``rng -> log-frame field``, optional
         Factory of knotted log fields (pith on log ``z``). When given, a block is knotted with
         probability ``knotted_fraction``, and a knotted block is cut with a knot crossing it
@@ -152,7 +161,9 @@ def knotted_log_field(rng: np.random.Generator, ring_width_range_mm: tuple[float
                       length_mm: float = 1200.0) -> KnottedLogField:
     """A knotted log field (log frame) from the log generator of seed 001 (``woodcam.logs``),
     turned into the stem + knot field of seed 003; ring width log-uniform in the range.
-    The factory :func:`synth_benchmark_set` takes as ``log_fields``."""
+    The factory :func:`synth_benchmark_set` takes as ``log_fields``. ``rng`` draws the log's
+    seed and the width; ``ring_width_range_mm``: (min, max) ring width, mm/year; ``length_mm``:
+    the log's length (default 1200 mm)."""
     from ..fields import KnottedLogField
     from ..logs import generate_log
 
@@ -162,7 +173,8 @@ def knotted_log_field(rng: np.random.Generator, ring_width_range_mm: tuple[float
 
 
 def time_synth_block(face_px: int = 512, repeats: int = 1) -> float:
-    """Seconds to synthesise one cube block with six ``face_px``-square faces (built-in colour)."""
+    """Seconds to synthesise one cube block with six ``face_px``-square faces (built-in colour),
+    the best of ``repeats`` runs."""
     log = AnalyticLogField(ring_width_mm=3.0, width_slope_per_mm=0.001, eccentricity=0.1, lobe_amplitude=0.02)
     field = cut_block(log, (50, 50, 50), "rift")
     best = math.inf

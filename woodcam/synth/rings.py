@@ -42,7 +42,10 @@ def ring_eval_faces(seed: int, face_px: int = 256, size_mm: float = 50.0,
 
     ``style``: ``"plain"``, the built-in wood colour (a smooth latewood ramp over the last 45 %
     of each ring); ``"realistic"``, :class:`woodcam.synth.photos._RealisticWood` (narrow softwood
-    latewood or ring-porous oak, drawn by the seed's parity; rays, figure, faint rings)."""
+    latewood or ring-porous oak, drawn by the seed's parity; rays, figure, faint rings).
+    ``face_px``: each face's side in pixels (default 256); ``ring_width_range_mm``: (min, max)
+    ring width at the cube, mm/year (log-uniform); ``faces``: the faces drawn (default all
+    six)."""
     from ..detect.evaluate import SyntheticFace, dense_polyline
 
     rng = np.random.default_rng(seed)
@@ -119,7 +122,8 @@ def ring_training_faces(spec: RingNetSpec, progress: bool = False,
     :func:`texture_sources` of ``spec.texture_samples``. Cube ``i`` is drawn in
     :func:`woodcam.detect.learned.cube_style` ``(spec.style, i)``; a quilted one is painted by
     :func:`woodcam.detect.quilt.quilt_face` with the textures of group ``i % len(sources)``
-    (one source face per synthetic face, drawn at random from the group)."""
+    (one source face per synthetic face, drawn at random from the group). ``progress``: bars on
+    stderr while texture photos are read and faces synthesised (off by default)."""
     from .._progress import progress_bar
 
     from ..detect.learned import QUILTED_STYLES, augment_photo, cube_style, net_input

@@ -641,7 +641,8 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
     deeper than its flutes), and a cone is refused. An entry's ``"number"`` is its tool number,
     as in CAMotics (Tool::read, then ToolTable::set files it under that number), the key
     without one; two entries on one number are refused (CAMotics keeps the later one without a
-    word). Lengths in the table's units; woodcam's tools in mm."""
+    word). Lengths in the table's units; woodcam's tools in mm. ``path``: the ``.camotics``
+    project or ``.json`` file."""
     import json
 
     path = Path(path)

@@ -329,8 +329,9 @@ def mesh_to_pyvista(mesh: Mesh) -> tuple[pv.PolyData, pv.Texture | None]:
 
 
 def block_outline(size_mm: ArrayLike, *, outset_mm: float = 0.0) -> tuple[pv.PolyData, pv.PolyData]:
-    """The block ``[0, W] x [0, D] x [0, H]`` as a box surface and its 12 edges, each face moved
-    ``outset_mm`` outwards (mm; the preview's :data:`BLOCK_OUTSET`).
+    """The block ``[0, W] x [0, D] x [0, H]`` (``size_mm = (W, D, H)``, block frame, mm) as a box
+    surface and its 12 edges, each face moved ``outset_mm`` outwards (mm; the preview's
+    :data:`BLOCK_OUTSET`).
 
     Returns
     -------
@@ -761,6 +762,10 @@ def build_scene(
     Parameters
     ----------
     plotter : pyvista.Plotter
+    mesh_or_path : trimesh.Trimesh, trimesh.Scene, str or Path
+        The part in the block frame (mm), as :func:`preview` takes it.
+    size_mm : (W, D, H) mm, optional
+        The block, drawn as a translucent box; needed with ``wood``.
     widget : bool
         With ``cut_plane``: add the interactive plane widget (bounded by the block), whose
         callback redraws the cut as it is dragged. Without ``widget`` the cut is drawn once at

@@ -84,7 +84,8 @@ class Brush:
 
 
 def load_brushes(path: PathLike) -> list[Brush]:
-    """Read a JSON brush file (module docstring): ``{"brushes": [...]}`` or the list alone."""
+    """Read the JSON brush file ``path`` (module docstring): ``{"brushes": [...]}`` or the list
+    alone."""
     path = check_path(path, "load_brushes: path", fix="pass the brush file, e.g. brushes.json")
     like = ('{"brushes": [{"centre_mm": [x, y, z], "radius_mm": r, "gain": 1.5, "direction": [0, 0, 1], '
             '"strength": 0.3}]}')

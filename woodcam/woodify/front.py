@@ -451,6 +451,8 @@ def sphere_arrival(points_mm: ArrayLike, centre_mm: ArrayLike, radius_mm: float,
     The eccentric front at pseudo-time ``T`` is the sphere offset by ``T`` and shifted by
     ``w T`` (Minkowski sum with a ball of radius ``T`` centred at ``w T``), so ``T`` solves
     ``|x - c - w T| = r0 + T``: a quadratic. Negative inside the input sphere (``-distance``).
+    ``points_mm``: ``(n, 3)`` mm; ``centre_mm`` (3,) and ``radius_mm``: the sphere ``c``,
+    ``r0``; ``wind``: ``w`` (3,), ``|w| < 1``. Returns ``(n,)`` mm.
     """
     p = np.asarray(points_mm, float) - np.asarray(centre_mm, float)
     w = np.asarray(wind, float)

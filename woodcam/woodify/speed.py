@@ -36,7 +36,8 @@ from ..errors import WoodcamError
 
 
 def weibull_speed(u: ArrayLike, shape: float = 2.0) -> np.ndarray:
-    """Eq. 4.1: ``s(u) = c u^(c-1) exp(-u^c)`` for ``u >= 0`` (dimensionless time)."""
+    """Eq. 4.1: ``s(u) = c u^(c-1) exp(-u^c)`` for ``u >= 0`` (dimensionless time), ``c`` the
+    Weibull ``shape`` (default 2)."""
     u = np.maximum(np.asarray(u, dtype=float), 0.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         s = shape * u ** (shape - 1.0) * np.exp(-u ** shape)
@@ -44,13 +45,15 @@ def weibull_speed(u: ArrayLike, shape: float = 2.0) -> np.ndarray:
 
 
 def weibull_cdf(u: ArrayLike, shape: float = 2.0) -> np.ndarray:
-    """``W(u) = 1 - exp(-u^c)`` for ``u >= 0``: the integral of eq. 4.1 from 0 to ``u``."""
+    """``W(u) = 1 - exp(-u^c)`` for ``u >= 0``: the integral of eq. 4.1 from 0 to ``u``; ``c``
+    the Weibull ``shape`` (default 2)."""
     u = np.maximum(np.asarray(u, dtype=float), 0.0)
     return -np.expm1(-u ** shape)
 
 
 def weibull_cdf_inv(q: ArrayLike, shape: float = 2.0) -> np.ndarray:
-    """``W^-1(q) = (-ln(1 - q))^(1/c)`` for ``q`` in [0, 1); ``inf`` for ``q >= 1``."""
+    """``W^-1(q) = (-ln(1 - q))^(1/c)`` for ``q`` in [0, 1); ``inf`` for ``q >= 1``; ``c`` the
+    Weibull ``shape`` (default 2)."""
     q = np.clip(np.asarray(q, dtype=float), 0.0, 1.0)
     with np.errstate(divide="ignore"):
         return (-np.log1p(-q)) ** (1.0 / shape)
