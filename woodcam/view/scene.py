@@ -371,7 +371,7 @@ def cut_plane_image(
     resolution_mm: float = SECTION_RESOLUTION_MM,
     *,
     max_samples: int | None = None,
-    part: Mesh | None = None,
+    part: Mesh | pv.PolyData | tuple[ArrayLike, ArrayLike] | None = None,
 ) -> pv.PolyData:
     """The wood on the part of a plane inside the block, as coloured polydata.
 
