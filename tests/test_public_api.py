@@ -187,28 +187,36 @@ def test_the_walk_through_calls_document_every_parameter():
     assert "block frame" in inspect.getdoc(woodcam.evaluate) and "mm" in inspect.getdoc(woodcam.evaluate)
 
 
-def test_the_sub_packages_exports_are_annotated():
-    """What a sub-package exports (woodcam/<pkg>/__init__.py __all__) is a Python door too, outside
-    woodcam.__all__: 47 of them left parameters or the return bare (woodify.propagate,
-    inference.score_face, logs.fit_*, view.build_scene, fields.check_points, ...)."""
+def _sub_package_functions():
+    """``(qualified name, function)`` of each function a sub-package exports
+    (woodcam/<pkg>/__init__.py ``__all__``), each function once."""
     import importlib
     import pkgutil
 
-    missing = []
+    seen = set()
     for info in pkgutil.iter_modules(woodcam.__path__):
         if not info.ispkg or info.name.startswith("_") or info.name == "examples":
             continue
         module = importlib.import_module(f"woodcam.{info.name}")
         for name in getattr(module, "__all__", ()):
             f = getattr(module, name)
-            if not inspect.isfunction(f):
-                continue
-            sig = inspect.signature(f)
-            bare = [p for p, v in sig.parameters.items() if v.annotation is inspect.Parameter.empty
-                    and v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)]
-            if bare or sig.return_annotation is inspect.Signature.empty:
-                missing.append(f"woodcam.{info.name}.{name}: {bare}"
-                               f"{' (no return)' if sig.return_annotation is inspect.Signature.empty else ''}")
+            if inspect.isfunction(f) and f not in seen:
+                seen.add(f)
+                yield f"woodcam.{info.name}.{name}", f
+
+
+def test_the_sub_packages_exports_are_annotated():
+    """What a sub-package exports (woodcam/<pkg>/__init__.py __all__) is a Python door too, outside
+    woodcam.__all__: 47 of them left parameters or the return bare (woodify.propagate,
+    inference.score_face, logs.fit_*, view.build_scene, fields.check_points, ...)."""
+    missing = []
+    for qualified, f in _sub_package_functions():
+        sig = inspect.signature(f)
+        bare = [p for p, v in sig.parameters.items() if v.annotation is inspect.Parameter.empty
+                and v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)]
+        if bare or sig.return_annotation is inspect.Signature.empty:
+            missing.append(f"{qualified}: {bare}"
+                           f"{' (no return)' if sig.return_annotation is inspect.Signature.empty else ''}")
     assert not missing, "add type hints:\n" + "\n".join(missing)
 
 
@@ -242,21 +250,11 @@ def test_the_sub_packages_exports_document_every_parameter():
     """42 functions the sub-packages export (outside woodcam.__all__) left parameters unnamed in
     their docstrings: woodify.weibull_*'s shape, logs.fit_surface_base's l_mm and theta_rad,
     view.build_scene's mesh_or_path and size_mm, synth.benchmark_set_block's seven keywords, ..."""
-    import importlib
-    import pkgutil
     import re
 
-    missing, seen = [], set()
-    for info in pkgutil.iter_modules(woodcam.__path__):
-        if not info.ispkg or info.name.startswith("_") or info.name == "examples":
-            continue
-        module = importlib.import_module(f"woodcam.{info.name}")
-        for name in getattr(module, "__all__", ()):
-            f = getattr(module, name)
-            if not inspect.isfunction(f) or f in seen:
-                continue
-            seen.add(f)
-            doc = inspect.getdoc(f) or ""
-            missing += [f"woodcam.{info.name}.{name}: {p}" for p in inspect.signature(f).parameters
-                        if p not in ("self", "args", "kwargs") and not re.search(rf"\b{re.escape(p)}\b", doc)]
+    missing = []
+    for qualified, f in _sub_package_functions():
+        doc = inspect.getdoc(f) or ""
+        missing += [f"{qualified}: {p}" for p in inspect.signature(f).parameters
+                    if p not in ("self", "args", "kwargs") and not re.search(rf"\b{re.escape(p)}\b", doc)]
     assert not missing, "document:\n" + "\n".join(missing)
