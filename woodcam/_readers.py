@@ -356,6 +356,17 @@ def check_state_shapes(expected: dict, state) -> None:
     raise ValueError(f"the weights are of another net than the spec (tensors {counts}; first {first})")
 
 
+def torch_archive_problem(path) -> str | None:
+    """Why the file ``path`` cannot be a ``torch.save`` file, a zip archive: ``"empty"``, ``"not
+    a zip archive"`` (cut short by a crash or copy, or another kind of file), or None. Checked
+    before ``torch.load``, whose errors for these say nothing useful (a bare ``EOFError``, a
+    paragraph about miniz). An unreadable file is the ``OSError`` of opening it."""
+    with open(path, "rb") as fh:
+        if zipfile.is_zipfile(fh):
+            return None
+    return "empty" if Path(path).stat().st_size == 0 else "not a zip archive"
+
+
 def torch_state(path, expected: dict, what: str = "torch weights") -> dict:
     """The tensors of the torch weights file ``path`` (``torch.save`` of a state dict), read with
     ``weights_only=True`` (a crafted pickle runs nothing) and checked against the net they are
@@ -367,11 +378,11 @@ def torch_state(path, expected: dict, what: str = "torch weights") -> dict:
     listed every tensor over many lines for another net's weights."""
     torch = require("torch", "learn", what)
     try:
-        with open(path, "rb") as fh:
-            if not zipfile.is_zipfile(fh):   # torch.save writes a zip archive
-                raise ValueError("the file is empty" if Path(path).stat().st_size == 0 else
-                                 "not a torch weights file (a zip archive): cut short by a crash or copy, "
-                                 "or another kind of file")
+        problem = torch_archive_problem(path)
+        if problem:
+            raise ValueError("the file is empty" if problem == "empty" else
+                             "not a torch weights file (a zip archive): cut short by a crash or copy, "
+                             "or another kind of file")
         state = torch.load(path, map_location="cpu", weights_only=True)
         check_state_shapes(expected, state)
     except Exception as err:  # torch raises RuntimeError, OSError, EOFError, UnpicklingError...

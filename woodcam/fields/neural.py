@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_path, atomic_write, write_text
-from .._readers import read_torch_state
+from .._readers import read_torch_state, torch_archive_problem
 from .._threads import restores_torch_threads
 from ..errors import WoodcamError, WoodcamWarning, require
 from .radial import laplacian_smoother
@@ -379,16 +379,14 @@ def _load_checkpoint(torch, ckpt: Path, spec: GTFSpec) -> dict:
     """A training checkpoint, loaded with ``weights_only=True``: tensors and plain data only, so a
     crafted file cannot run code (a pickle that needs anything else is refused)."""
     import pickle
-    import zipfile
 
     fix = "delete it or pass resume=False (CLI: --no-resume) to start afresh"
     try:
-        with open(ckpt, "rb") as fh:
-            whole = zipfile.is_zipfile(fh)   # torch.save writes a zip archive
+        problem = torch_archive_problem(ckpt)
     except OSError as err:
         raise WoodcamError(f"checkpoint {ckpt} cannot be read ({err.strerror}); {fix}") from err
-    if not whole:  # a run killed mid-write never leaves this (atomic writes): a copy or a disk did
-        what = "empty" if ckpt.stat().st_size == 0 else "cut short or another kind of file (not a zip archive)"
+    if problem:  # a run killed mid-write never leaves this (atomic writes): a copy or a disk did
+        what = "empty" if problem == "empty" else "cut short or another kind of file (not a zip archive)"
         raise WoodcamError(f"checkpoint {ckpt} is {what}; {fix}")
     try:
         state = torch.load(ckpt, map_location="cpu", weights_only=True)
