@@ -136,9 +136,9 @@ def test_an_appearance_shows_its_species_by_name():
     """A knotty stock's Wood repr was one line of 1098 characters, a third of it the Species'
     ten numbers and its source sentence, printed through the ColorMapAppearance."""
     text = repr(woodcam.open_stock("builtin:knotty").wood)
-    assert "appearance=ColorMapAppearance(species=<Species 'spruce'>, axis_luts=None" in text
+    assert "appearance=ColorMapAppearance(species=<Species 'spruce'>)" in text  # the Nones left out
     assert "earlywood_rgb" not in text and "source=" not in text and len(text) < 800, text
-    assert repr(woodcam.ColorMapAppearance("walnut")).startswith("ColorMapAppearance(species=<Species 'walnut'>, ")
+    assert repr(woodcam.ColorMapAppearance("walnut")) == "ColorMapAppearance(species=<Species 'walnut'>)"
 
 
 def test_the_python_entry_points_the_readme_names_are_annotated():
@@ -258,3 +258,20 @@ def test_the_sub_packages_exports_document_every_parameter():
         missing += [f"{qualified}: {p}" for p in inspect.signature(f).parameters
                     if p not in ("self", "args", "kwargs") and not re.search(rf"\b{re.escape(p)}\b", doc)]
     assert not missing, "document:\n" + "\n".join(missing)
+
+
+def test_a_woods_repr_is_short_with_plain_numbers():
+    """A knotty stock's Wood repr was 754 characters: its LogFrame held numpy scalars
+    ('axis=(np.float64(0.0), np.float64(-0.0), np.float64(1.0))') and points to 15 digits, and
+    its ColorMapAppearance listed the eight optional fields left at None."""
+    import numpy as np
+
+    text = repr(woodcam.open_stock("builtin:knotty").wood)
+    assert "np.float64" not in text and len(text) < 500, (len(text), text)
+    assert "frame=LogFrame(pith_point_mm=(50, 95, -315.685), axis=(0, 0, 1), reference=(0, -1, 0))" in text, text
+    assert "appearance=ColorMapAppearance(species=<Species 'spruce'>), threads=" in text, text
+    frame = woodcam.LogFrame(np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.0, 2.0]), np.array([1.0, 0.0, 0.0]))
+    assert frame.axis == (0.0, 0.0, 2.0) and all(type(v) is float for v in frame.axis + frame.reference)
+    assert frame == woodcam.LogFrame((1, 2, 3), (0, 0, 2), (1, 0, 0)) and hash(frame) == hash(
+        woodcam.LogFrame((1, 2, 3), (0, 0, 2), (1, 0, 0)))
+    assert repr(woodcam.ColorMapAppearance("walnut", seed=3)) == "ColorMapAppearance(species=<Species 'walnut'>, seed=3)"

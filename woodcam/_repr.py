@@ -44,12 +44,30 @@ def short(value: object) -> str:
     return repr(value)
 
 
-def summary_repr(self: object) -> str:
+def summary_repr(self: object, *, skip_defaults: bool = False) -> str:
     """A dataclass's repr with each shown field through :func:`short`: ``Name(a=..., b=...)``.
-    Assign it as ``__repr__ = summary_repr`` in the class body (the dataclass then keeps it)."""
+    Assign it as ``__repr__ = summary_repr`` in the class body (the dataclass then keeps it).
+    ``skip_defaults=True`` leaves out the fields still at their declared default (a class with
+    many optional tables, most of them None)."""
     parts = [f"{f.name}={short(getattr(self, f.name))}" for f in dataclasses.fields(self)  # type: ignore[arg-type]
-             if f.repr]
+             if f.repr and not (skip_defaults and _is_default(getattr(self, f.name), f))]
     return f"{type(self).__qualname__}({', '.join(parts)})"
+
+
+def _is_default(value: object, f: dataclasses.Field) -> bool:
+    """Whether ``value`` is field ``f``'s declared default: the same object, or an equal one of
+    the same type that is not an array (an array's ``==`` is elementwise, never a yes or no)."""
+    default = f.default
+    if default is dataclasses.MISSING:
+        return False
+    if value is default:
+        return True
+    if type(value) is not type(default) or hasattr(value, "__array__"):
+        return False
+    try:
+        return bool(value == default)
+    except Exception:  # an __eq__ that cannot say: show the value
+        return False
 
 
 def attrs_repr(obj: object, names: tuple[str, ...]) -> str:

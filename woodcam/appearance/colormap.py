@@ -274,8 +274,9 @@ class ColorMapAppearance:
 
     def __repr__(self) -> str:
         # arrays as shapes (summary_repr), and the species by its name: its ten numbers and its
-        # source sentence made a knotty stock's Wood repr one line of ~1100 characters
-        text = summary_repr(self)
+        # source sentence made a knotty stock's Wood repr one line of ~1100 characters; the
+        # optional tables left at their defaults (None, mostly) are left out
+        text = summary_repr(self, skip_defaults=True)
         species = self.species
         if isinstance(species, Species):
             text = text.replace(f"species={species!r}", f"species=<Species {species.name!r}>", 1)

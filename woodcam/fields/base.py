@@ -218,17 +218,30 @@ class LogFrame:
             self.pith_point_mm, "pith_point_mm", fix="pass a block-frame point on the pith, mm")))
         z = check_vector(self.axis, "axis", unit=True,
                          fix="pass the log axis as a block-frame direction, e.g. (0, 0, 1)")
+        # axis and reference kept as given but as plain floats, as pith_point_mm: numpy scalars
+        # (a placement's computed axis) printed as np.float64(0.0) in every Wood repr
+        object.__setattr__(self, "axis", _plain(self.axis))
         ref = self.reference
         if ref is None:
             ref = (1.0, 0.0, 0.0) if abs(z[0]) < 0.9 else (0.0, 1.0, 0.0)
         x = check_vector(ref, "reference", unit=True,
                          fix="pass a block-frame direction across the axis, e.g. (1, 0, 0), or None")
+        if self.reference is not None:
+            object.__setattr__(self, "reference", _plain(self.reference))
         x = x - z * (x @ z)
         if np.linalg.norm(x) < 1e-9:
             raise WoodcamError(f"reference must not be parallel to axis; got {ref!r} and {self.axis!r}")
         x /= np.linalg.norm(x)
         y = np.cross(z, x)
         object.__setattr__(self, "_rot", np.stack([x, y, z]))  # rows: log axes in block frame
+
+    def __repr__(self) -> str:
+        # one short line inside a field's and a Wood's repr: six significant digits (1 um under
+        # a metre), -0 as 0; the names carry the units (mm; axis and reference are directions)
+        def vec(v: tuple[float, ...] | None) -> str:
+            return "None" if v is None else f"({', '.join(f'{x + 0.0:.6g}' for x in v)})"
+        return (f"LogFrame(pith_point_mm={vec(self.pith_point_mm)}, axis={vec(self.axis)}, "
+                f"reference={vec(self.reference)})")
 
     @property
     def rotation(self) -> np.ndarray:
@@ -268,6 +281,12 @@ class LogFrame:
     def direction_to_log(self, dirs_mm: ArrayLike) -> np.ndarray:
         """Rotate block-frame direction vectors ``(n, 3)`` (fibres, normals) into the log frame."""
         return np.einsum("ij,kj->ik", _directions(dirs_mm, "dirs_mm"), self._rot)
+
+
+def _plain(v: ArrayLike) -> tuple[float, float, float]:
+    """A checked ``(3,)`` vector as a tuple of Python floats (not numpy scalars)."""
+    x, y, z = (float(c) for c in np.asarray(v, dtype=float).ravel())
+    return (x, y, z)
 
 
 def _directions(value, name: str) -> np.ndarray:
