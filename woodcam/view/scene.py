@@ -49,6 +49,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     import pyvista as pv
+    import trimesh
 
 #: Default sample spacing (mm) of the wood on a cut plane: finer than a 0.5 mm latewood band.
 SECTION_RESOLUTION_MM = 0.25
@@ -280,13 +281,14 @@ def _material_image(material):
     return image
 
 
-def mesh_to_pyvista(mesh: Mesh) -> tuple[pv.PolyData, pv.Texture | None]:
+def mesh_to_pyvista(mesh: Mesh | trimesh.Scene | PathLike) -> tuple[pv.PolyData, pv.Texture | None]:
     """Convert a trimesh mesh to pyvista, keeping its texture or colours.
 
     Parameters
     ----------
-    mesh : trimesh.Trimesh
-        Triangles in the block frame (mm). With ``TextureVisuals`` (``uv : (n_vertices, 2)``,
+    mesh : trimesh.Trimesh, trimesh.Scene, str or Path
+        Triangles in the block frame (mm); a scene's meshes are concatenated and a file is read
+        as :func:`preview` reads it. With ``TextureVisuals`` (``uv : (n_vertices, 2)``,
         ``v = 1`` at the image's top row, material image as PIL), the uv become the polydata's
         active texture coordinates and the image a ``pv.Texture`` (VTK also puts ``v = 1`` at
         the top row, so the image is used as stored). Vertex or face colours become an ``RGB``
@@ -746,7 +748,7 @@ class SceneOptions:
 
 def build_scene(
     plotter: pv.Plotter,
-    mesh_or_path: Mesh | PathLike,
+    mesh_or_path: Mesh | trimesh.Scene | PathLike,
     *,
     wood: WoodLike | None = None,
     size_mm: ArrayLike | None = None,
@@ -874,7 +876,7 @@ def check_overlay(overlay) -> list[tuple[np.ndarray, object, float]]:
 
 
 def preview(
-    mesh_or_path: Mesh | PathLike,
+    mesh_or_path: Mesh | trimesh.Scene | PathLike,
     *,
     wood: WoodLike | None = None,
     size_mm: ArrayLike | None = None,
