@@ -733,8 +733,8 @@ _T = [{"filename": "t.png"}]
     ({"targets": _T, "woodcam": {"mokume": "CN03"}}, r"'woodcam.mokume' must be a list"),
     ({"targets": _T, "woodcam": {"blocks": [{"spec": "builtin:flat-sawn", "sheets": "2"}]}},
      r"woodcam.blocks\[0\].sheets must be a whole number; got '2'"),
-    ({"targets": _T, "num_source_rotations": "abc"}, r"n_rot must be a whole number; got 'abc'"),
-    ({"targets": _T, "num_source_rotations": 0}, r"n_rot must be in \[1, 360\]"),
+    ({"targets": _T, "num_source_rotations": "abc"}, r"num_source_rotations must be a whole number; got 'abc'"),
+    ({"targets": _T, "num_source_rotations": 0}, r"num_source_rotations must be in \[1, 360\]"),
     ({"targets": _T, "woodcam": {"params": {"patch_mm": "14"}}}, r"patch_mm must be a finite number"),
     ({"targets": _T, "woodcam": {"params": {"single_use": 1}}}, r"single_use must be true or false"),
     ([_T], r"must hold a JSON object; got list"),
@@ -767,6 +767,45 @@ def test_a_bad_job_file_is_one_error_naming_the_entry(job, match, tmp_path):
     (tmp_path / "job.json").write_text(json.dumps(job))
     with pytest.raises(WoodcamError, match=match):
         read_job(tmp_path / "job.json")
+
+
+@pytest.mark.parametrize("job, said", [
+    ({"num_source_rotations": "abc"}, "num_source_rotations must be a whole number; got 'abc'; remove the key for "
+     "the default, 15"),
+    ({"woodcam": {"params": {"patch_mm": "14"}}}, "woodcam.params.patch_mm must be a finite number; got '14'; "
+     "remove the key for the default, 14.0"),
+    ({"woodcam": {"params": {"overlap_mm": "a"}}}, "woodcam.params.overlap_mm must be a finite number; got 'a'; "
+     "remove the key for the default"),
+    ({"woodcam": {"params": {"patch_mm": 3}}}, "woodcam.params.patch_mm must be at least "
+     "woodcam.params.min_piece_mm = 5 mm (the smallest piece that can be cut and assembled); got 3 mm; use a "
+     "larger woodcam.params.patch_mm or lower woodcam.params.min_piece_mm"),
+    ({"woodcam": {"params": {"overlap_mm": 6}}}, "woodcam.params.overlap_mm must be in [0, (woodcam.params.patch_mm "
+     "- woodcam.params.min_piece_mm) / 2 = (14 - 5) / 2 = 4.5] mm so every piece stays >= woodcam.params.min_piece_mm "
+     "wide; got 6 mm; use woodcam.params.overlap_mm 4.5 or less, a larger woodcam.params.patch_mm or a smaller "
+     "woodcam.params.min_piece_mm"),
+    ({"patch_levels": 9}, "patch_levels must be in [0, 4] here: its largest patch, woodcam.params.patch_mm * "
+     "2^patch_levels = 14 * 2^9 = 7168 mm"),
+    ({"woodcam": {"params": {"flat_rerank": 2}}}, "woodcam.params.flat_rerank must be >= woodcam.params.rerank = 4 "
+     "(the candidates every patch re-ranks); got 2; use woodcam.params.flat_rerank 4 to turn"),
+    ({"woodcam": {"params": {"bogus": 2}}}, "key woodcam.params.bogus is unknown; known: ['coarse_factor', "),
+])
+def test_a_job_files_bad_parameter_is_said_in_its_keys(job, said, tmp_path):
+    """A job file's bad parameter was said in Python terms: 'parquetry parameter n_rot must be a
+    whole number; got 'abc'; leave it out for the default, n_rot=15' of the file's
+    num_source_rotations, 'use --overlap-mm 4.5' of its woodcam.params.overlap_mm, and without
+    the file's name; the same values given in Python keep Python's words."""
+    path = tmp_path / "job.json"
+    path.write_text(json.dumps({"targets": _T, **job}))
+    with pytest.raises(WoodcamError) as info:
+        read_job(path)
+    text = str(info.value)
+    assert text.startswith(f"job file {str(path)!r}: {said}"), text
+    assert "n_rot=" not in text and "--" not in text and "parquetry parameter" not in text, text
+    with pytest.raises(WoodcamError, match=r"parquetry parameter n_rot must be a whole number; got 'abc'; leave it "
+                       r"out for the default, n_rot=15$"):
+        ParquetryParams(n_rot="abc")
+    with pytest.raises(WoodcamError, match=r"^overlap_mm \(--overlap-mm\) must be .*; use --overlap-mm 4.5 or less"):
+        ParquetryParams(overlap_mm=6)
 
 
 def test_a_job_files_missing_file_is_named_by_its_entry_and_folder(tmp_path, monkeypatch):

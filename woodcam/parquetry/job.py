@@ -117,81 +117,90 @@ class ParquetryParams:
         # and failed (or ran) only when a run called check()
         self.check()
 
-    def check(self) -> ParquetryParams:
-        """Validate (done when made; call again after changing a field); returns self."""
+    def check(self, *, said: _Said | None = None) -> ParquetryParams:
+        """Validate (done when made; call again after changing a field); returns self.
+        ``said``: how the errors name the parameters (:func:`read_job` names a job file's keys);
+        default: their Python names, with the command line's options in the fixes."""
+        n = said or _Said()
         for f in fields(self):  # the types first: a job file's "abc" or NaN fails here, by name
-            setattr(self, f.name, _check_type(f"parquetry parameter {f.name}", getattr(self, f.name), str(f.type),
-                                              fix=f"leave it out for the default, {f.name}={f.default!r}"))
+            setattr(self, f.name, _check_type(n.where + n.typed(f.name), getattr(self, f.name), str(f.type),
+                                              fix=n.default_fix(f.name, f.default)))
         if not 1 <= self.n_rot <= 360:  # 1e9 filled the memory before the search's own estimate
-            raise WoodcamError(f"n_rot must be in [1, 360] (rotated copies of each sheet, sec. 3.2); got {self.n_rot}")
+            raise n.error(f"{n('n_rot')} must be in [1, 360] (rotated copies of each sheet, sec. 3.2); "
+                          f"got {self.n_rot}")
         if not 0 < self.px_per_mm <= 50:  # 200 px/mm asked OpenCV for 1.6 GB on a 100 mm veneer
-            raise WoodcamError(f"px_per_mm must be in (0, 50] (the working resolution; 4 is the paper's "
-                               f"scale); got {self.px_per_mm}")
+            raise n.error(f"{n('px_per_mm')} must be in (0, 50] (the working resolution; 4 is the paper's "
+                          f"scale); got {self.px_per_mm}")
         if self.min_piece_mm < 0:
-            raise WoodcamError(f"min_piece_mm must be >= 0 mm; got {self.min_piece_mm}")
+            raise n.error(f"{n('min_piece_mm')} must be >= 0 mm; got {self.min_piece_mm}")
         for name in ("w_intens", "w_edge", "w_hist"):
             v = getattr(self, name)
             if not 0.0 <= v <= 1.0:
-                raise WoodcamError(f"{name} must be in [0, 1] (eq. 1-2 of seed 002); got {v}")
+                raise n.error(f"{n(name)} must be in [0, 1] (eq. 1-2 of seed 002); got {v}")
         if self.w_intens + self.w_edge <= 0:
-            raise WoodcamError("w_intens + w_edge must be > 0; both are 0, nothing would be matched")
+            raise n.error(f"{n('w_intens')} + {n('w_edge')} must be > 0; both are 0, nothing would be matched")
         if self.patch_mm < self.min_piece_mm:
-            raise WoodcamError(
-                f"patch_mm must be at least min_piece_mm = {self.min_piece_mm:g} mm (the smallest "
+            raise n.error(
+                f"{n('patch_mm')} must be at least {n('min_piece_mm')} = {self.min_piece_mm:g} mm (the smallest "
                 f"piece that can be cut and assembled); got {self.patch_mm:g} mm; use a larger "
-                "--patch-mm or lower --min-piece-mm")
+                f"{n.opt('patch_mm')} or lower {n.opt('min_piece_mm')}")
         cap = limit("MAX_BLOCK_SIZE_MM")
         if not self.patch_mm <= self.image_size_mm <= cap:  # 1e300 reached OpenCV's assertion
-            raise WoodcamError(f"image_size_mm (--image-size-mm) must be in [patch_mm = {self.patch_mm:g}, "
-                               f"{cap:g}] mm; got {self.image_size_mm:g}; raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N")
+            raise n.error(f"{n('image_size_mm', opt=True)} must be in [{n('patch_mm')} = {self.patch_mm:g}, "
+                          f"{cap:g}] mm; got {self.image_size_mm:g}; raise it with WOODCAM_MAX_BLOCK_SIZE_MM=N")
         if self.n_adaptive < 0 or self.w_adaptive <= 0:
-            raise WoodcamError(f"n_adaptive must be >= 0 and w_adaptive > 0; got {self.n_adaptive}, {self.w_adaptive}")
+            raise n.error(f"{n('n_adaptive')} must be >= 0 and {n('w_adaptive')} > 0; got {self.n_adaptive}, "
+                          f"{self.w_adaptive}")
         if self.priority not in ("saliency", "center"):
-            raise WoodcamError(f"priority must be one of ['saliency', 'center']; got {self.priority!r}")
+            raise n.error(f"{n('priority')} must be one of ['saliency', 'center']; got {self.priority!r}")
         if self.queue not in ("interleaved", "sequential"):
-            raise WoodcamError(f"queue must be one of ['interleaved', 'sequential']; got {self.queue!r}")
+            raise n.error(f"{n('queue')} must be one of ['interleaved', 'sequential']; got {self.queue!r}")
         if self.mode not in ("fast", "exhaustive"):
-            raise WoodcamError(f"mode must be one of ['fast', 'exhaustive']; got {self.mode!r}")
+            raise n.error(f"{n('mode')} must be one of ['fast', 'exhaustive']; got {self.mode!r}")
         if self.px_per_mm <= 0 or (self.kerf_mm or 0) < 0:
-            raise WoodcamError("px_per_mm must be > 0 and kerf_mm >= 0; got "
-                               f"{self.px_per_mm}, {self.kerf_mm}")
+            raise n.error(f"{n('px_per_mm')} must be > 0 and {n('kerf_mm')} >= 0; got "
+                          f"{self.px_per_mm}, {self.kerf_mm}")
         if not self.tool_diameter_mm > 0:  # 0: tool paths on the outlines, no kerf between pieces
-            raise WoodcamError(f"tool_diameter_mm (--tool-diameter) must be > 0 mm: the router bit cuts a "
-                               f"groove that wide, and its paths are offset by half of it; got "
-                               f"{self.tool_diameter_mm:g}; give the bit's diameter, e.g. 2 (set kerf_mm "
-                               "apart for the wood lost between pieces)")
+            raise n.error(f"{n('tool_diameter_mm', opt=True)} must be > 0 mm: the router bit cuts a "
+                          f"groove that wide, and its paths are offset by half of it; got "
+                          f"{self.tool_diameter_mm:g}; give the bit's diameter, e.g. 2 (set {n('kerf_mm')} "
+                          "apart for the wood lost between pieces)")
         if self.w_struct < 0 or self.rerank < 1:
-            raise WoodcamError(f"w_struct must be >= 0 and rerank >= 1; got {self.w_struct}, {self.rerank}")
+            raise n.error(f"{n('w_struct')} must be >= 0 and {n('rerank')} >= 1; got {self.w_struct}, "
+                          f"{self.rerank}")
         if self.flat_detail < 1.0:
-            raise WoodcamError(f"flat_detail (--flat-detail) must be >= 1; got {self.flat_detail}; use 1 to turn "
-                               "the flat-window weighting off")
+            raise n.error(f"{n('flat_detail', opt=True)} must be >= 1; got {self.flat_detail}; use "
+                          f"{n.value('flat_detail', 1)} to turn the flat-window weighting off")
         # the one floor of flat_rerank (the CLI's range leaves it here): the candidates the
         # structural re-rank takes anyway, rerank
         if self.flat_rerank < self.rerank:
-            raise WoodcamError(f"flat_rerank (--flat-rerank) must be >= rerank = {self.rerank} (the candidates "
-                               f"every patch re-ranks); got {self.flat_rerank}; use {self.rerank} to turn the "
-                               "flat-window re-rank off")
+            raise n.error(f"{n('flat_rerank', opt=True)} must be >= {n('rerank')} = {self.rerank} (the "
+                          f"candidates every patch re-ranks); got {self.flat_rerank}; use "
+                          f"{n.value('flat_rerank', self.rerank)} to turn the flat-window re-rank off")
         if (self.coarse_factor is not None and self.coarse_factor < 1) or self.top_k < 1:
-            raise WoodcamError(f"coarse_factor and top_k must be >= 1; got {self.coarse_factor}, {self.top_k}")
+            raise n.error(f"{n('coarse_factor')} and {n('top_k')} must be >= 1; got {self.coarse_factor}, "
+                          f"{self.top_k}")
         if self.patch_px < 4:
-            raise WoodcamError(f"patch_mm * px_per_mm must give at least 4 px; got {self.patch_px}; "
-                               "raise px_per_mm")
+            raise n.error(f"{n('patch_mm')} * {n('px_per_mm')} must give at least 4 px; got {self.patch_px}; "
+                          f"raise {n('px_per_mm')}")
         # after patch_px: a patch of no size has no cells to count
         if self.n_adaptive > self.max_adaptive:  # compared in levels: a job file may hold any int
             largest = f"{self.patch_mm * 2.0 ** self.n_adaptive:g} mm" if self.n_adaptive <= 64 else "beyond any panel"
-            raise WoodcamError(
-                f"n_adaptive (--n-adaptive) must be in [0, {self.max_adaptive}] here: its largest patch, patch_mm * "
-                f"2^n_adaptive = {self.patch_mm:g} * 2^{self.n_adaptive} = {largest}, must fit the panel's shorter "
-                f"side, {self.short_side_mm:g} mm ({self.short_cells} patches: image_size_mm {self.image_size_mm:g} "
-                f"in whole patches); got {self.n_adaptive}; use --n-adaptive {self.max_adaptive} or less, or a larger "
-                "--image-size-mm")
+            raise n.error(
+                f"{n('n_adaptive', opt=True)} must be in [0, {self.max_adaptive}] here: its largest patch, "
+                f"{n('patch_mm')} * 2^{n('n_adaptive')} = {self.patch_mm:g} * 2^{self.n_adaptive} = {largest}, must "
+                f"fit the panel's shorter side, {self.short_side_mm:g} mm ({self.short_cells} patches: "
+                f"{n('image_size_mm')} {self.image_size_mm:g} in whole patches); got {self.n_adaptive}; use "
+                f"{n.setting('n_adaptive', self.max_adaptive)} or less, or a larger {n.opt('image_size_mm')}")
         o = self.overlap
         if o < 0 or 2 * o > self.patch_mm - self.min_piece_mm + 1e-9:
             most = (self.patch_mm - self.min_piece_mm) / 2
-            raise WoodcamError(
-                f"overlap_mm (--overlap-mm) must be in [0, (patch_mm - min_piece_mm) / 2 = ({self.patch_mm:g} - "
-                f"{self.min_piece_mm:g}) / 2 = {most:g}] mm so every piece stays >= min_piece_mm wide; got {o:g} mm; "
-                f"use --overlap-mm {most:g} or less, a larger --patch-mm or a smaller --min-piece-mm")
+            raise n.error(
+                f"{n('overlap_mm', opt=True)} must be in [0, ({n('patch_mm')} - {n('min_piece_mm')}) / 2 = "
+                f"({self.patch_mm:g} - {self.min_piece_mm:g}) / 2 = {most:g}] mm so every piece stays >= "
+                f"{n('min_piece_mm')} wide; got {o:g} mm; "
+                f"use {n.setting('overlap_mm', most)} or less, a larger {n.opt('patch_mm')} or a smaller "
+                f"{n.opt('min_piece_mm')}")
         return self
 
     @property
@@ -240,6 +249,57 @@ class ParquetryParams:
     @property
     def overlap_px(self) -> int:
         return round(self.overlap * self.px_per_mm)
+
+
+#: The command-line option of each parameter the Python messages name in their fixes.
+_OPTIONS = {"image_size_mm": "--image-size-mm", "patch_mm": "--patch-mm", "min_piece_mm": "--min-piece-mm",
+            "overlap_mm": "--overlap-mm", "n_adaptive": "--n-adaptive", "tool_diameter_mm": "--tool-diameter",
+            "flat_detail": "--flat-detail", "flat_rerank": "--flat-rerank"}
+
+
+class _Said:
+    """How :meth:`ParquetryParams.check` names a parameter, and a setting of it in a fix.
+
+    Default: the Python keyword (``patch_mm``), the command-line option beside it or in a fix
+    (``overlap_mm (--overlap-mm)``, ``use --overlap-mm 4.5``), and ``patch_mm=14.0`` for a
+    default. With ``where`` (a job file, ``"job file 'job.json': "``) and ``keys`` (parameter ->
+    the key the file wrote it under: ``num_source_rotations``, else ``woodcam.params.<name>``):
+    the file and its JSON keys only (``use woodcam.params.overlap_mm 4.5``); a job-file
+    user was told a Python keyword (``n_rot=15``) for a key the file spells otherwise."""
+
+    def __init__(self, where: str = "", keys: dict[str, str] | None = None):
+        self.where, self.keys = where, keys
+
+    def __call__(self, name: str, *, opt: bool = False) -> str:
+        """The parameter ``name`` as the subject of a rule (``opt``: with its option, in Python's)."""
+        if self.keys is not None:
+            return self.keys.get(name, f"woodcam.params.{name}")
+        return f"{name} ({_OPTIONS[name]})" if opt else name
+
+    def typed(self, name: str) -> str:
+        """The subject of a type error (Python: 'parquetry parameter n_rot')."""
+        return self(name) if self.keys is not None else f"parquetry parameter {name}"
+
+    def opt(self, name: str) -> str:
+        """The thing to change in a fix: the option (Python's messages) or the job file's key."""
+        return self(name) if self.keys is not None else _OPTIONS[name]
+
+    def setting(self, name: str, value: float) -> str:
+        """``name`` set to ``value`` in a fix: ``--overlap-mm 4.5``, ``woodcam.params.overlap_mm 4.5``."""
+        return f"{_OPTIONS[name] if self.keys is None else self(name)} {value:g}"
+
+    def value(self, name: str, value: float) -> str:
+        """``value`` for ``name`` in a fix: the number alone (Python's messages), or as :meth:`setting`."""
+        return f"{value:g}" if self.keys is None else self.setting(name, value)
+
+    def default_fix(self, name: str, default: object) -> str:
+        """The fix of a value of the wrong type: leave it out for its default."""
+        if self.keys is None:
+            return f"leave it out for the default, {name}={default!r}"
+        return "remove the key for the default" + ("" if default is None else f", {json.dumps(default)}")
+
+    def error(self, message: str) -> WoodcamError:
+        return WoodcamError(self.where + message)
 
 
 def _check_type(what: str, v, annotation: str, fix: str = ""):
@@ -455,17 +515,25 @@ def read_job(path: str | Path) -> ParquetryJob:
     base = p.parent
     names = {f.name for f in fields(ParquetryParams)}
     kw = {}
+    keys = {}  # each parameter by the key the file wrote it under, for check()'s errors
     for k, v in d.items():
         if k in _PAPER_KEYS:
             kw[_PAPER_KEYS[k]] = v
+            keys[_PAPER_KEYS[k]] = k
         elif k == "sort_patches_saliency":  # "no" was read as true
             kw["priority"] = "saliency" if _check_type(f"{where} {k}", v, "bool") else "center"
+            keys["priority"] = k
     for k, v in extra.get("params", {}).items():
         if k not in names:
-            raise WoodcamError(f"job file key woodcam.params.{k} is unknown; known: {sorted(names)}")
+            raise WoodcamError(f"{where} key woodcam.params.{k} is unknown; known: {sorted(names)}")
         kw[k] = v
+        keys.pop(k, None)  # woodcam.params wins over the paper's key (the order kw was filled in)
 
-    params = ParquetryParams(**kw).check()
+    # checked in the file's words (its keys, its path), not as ParquetryParams(**kw) would say it
+    params = ParquetryParams()
+    for k, v in kw.items():
+        setattr(params, k, v)
+    params.check(said=_Said(f"{where} ", keys))
 
     def _abs(s):
         return str((base / s).resolve()) if s else s
