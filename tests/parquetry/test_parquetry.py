@@ -7,6 +7,7 @@ taken from memory.
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -978,7 +979,12 @@ def test_mask_of_another_size(tmp_path):
 
     Image.new("RGB", (40, 30), (200, 150, 100)).save(tmp_path / "s.png")
     Image.new("L", (20, 30), 255).save(tmp_path / "m.png")
-    with pytest.raises(WoodcamError, match="mask must have the image's size 40x30 px; got 20x30"):
+    # both files named: 'the mask must have the image's size 40x30 px; got 20x30' named neither,
+    # and a job of several scans and masks left the user to find which
+    with pytest.raises(WoodcamError, match=re.escape(
+            f"veneer 's': its mask {str(tmp_path / 'm.png')!r} is 20x30 px and its scan {str(tmp_path / 's.png')!r} "
+            "40x30 px; the mask must have the scan's size (one mask pixel per scan pixel); resample the mask to "
+            "the scan")):
         load_scan(tmp_path / "s.png", dpi=100, mask=tmp_path / "m.png")
 
 
@@ -987,8 +993,27 @@ def test_zero_usable_wood(tmp_path):
 
     Image.new("RGB", (40, 30), (200, 150, 100)).save(tmp_path / "s.png")
     Image.new("L", (40, 30), 0).save(tmp_path / "m.png")
-    with pytest.raises(WoodcamError, match="zero usable wood"):
+    with pytest.raises(WoodcamError, match=re.escape(
+            f"veneer 's' has zero usable wood: its mask {str(tmp_path / 'm.png')!r} has no white pixel (white, a "
+            "mean of R, G and B above half, marks usable wood); paint the usable wood white, or give no mask")):
         load_scan(tmp_path / "s.png", dpi=100, mask=tmp_path / "m.png")
+    # a scan given no mask whose pixels are all transparent was told 'its mask is empty; check
+    # the mask (white = usable wood)'
+    Image.new("RGBA", (40, 30), (200, 150, 100, 0)).save(tmp_path / "cutout.png")
+    with pytest.raises(WoodcamError, match=re.escape(
+            f"veneer 'cutout' has zero usable wood: every pixel of the scan {str(tmp_path / 'cutout.png')!r} is "
+            "transparent (a cut-out's background is no wood)")) as info:
+        load_scan(tmp_path / "cutout.png", dpi=100)
+    assert "mask" not in str(info.value)
+    # half transparent, the mask white only over the transparent half: said as such
+    a = np.zeros((30, 40, 4), np.uint8)
+    a[..., :3], a[:, :20, 3] = 150, 255
+    Image.fromarray(a).save(tmp_path / "half.png")
+    m = np.zeros((30, 40), np.uint8)
+    m[:, 20:] = 255
+    Image.fromarray(m).save(tmp_path / "right.png")
+    with pytest.raises(WoodcamError, match=r"has no white pixel where the scan is opaque \(white"):
+        load_scan(tmp_path / "half.png", dpi=100, mask=tmp_path / "right.png")
 
 
 def test_patch_below_min_piece():

@@ -77,7 +77,8 @@ def test_cli_run_writes_everything(scans, capsys):
 @pytest.mark.parametrize("args, message, code", [
     # a missing target is a wrong command line, refused at the input door (exit 2; it was 1)
     (["{d}/nope.png", "--veneer", "{d}/light.png"], "TARGET of 'woodcam parquetry': '{d}/nope.png' does not exist", 2),
-    (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "mask must have the image's size", 1),
+    (["{d}/coffee.png", "--veneer", "{d}/light.png:300:{d}/coffee.png"], "veneer 'light': its mask '{d}/coffee.png' "
+     "is ", 1),
     (["{d}/coffee.png", "--veneer", "{d}/light.png:2000"], "smaller than one patch", 1),
     # no veneers on the command line and no job file: a wrong command line (exit 2; it was 1,
     # after the run had begun), as test_no_target_or_no_veneers_is_a_usage_error_before_any_work

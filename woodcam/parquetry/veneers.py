@@ -244,6 +244,8 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     # colour stored under them, and pieces were cut from them
     image, opaque = read_image_file_opacity(path, "veneer scan", None)
     rgb = _float_rgb(photo_rgb8(image))
+    vid = id or Path(path).stem
+    mask_file = None
     if mask is None:
         m = np.ones(rgb.shape[:2], bool)
     elif isinstance(mask, (np.ndarray, list)):
@@ -256,11 +258,30 @@ def load_scan(path: str | Path, *, dpi: float | None = None, px_per_mm: float | 
     else:
         # white where the mean of R, G, B over 255 is above 0.5, on the 8-bit values: the float
         # image (12 bytes a pixel) of a scan-sized mask was made only to be thresholded
-        m = read_photo_rgb(check_path(mask, "load_scan: mask", fix="an image file or an (h, w) bool array"),
-                           "veneer mask", MASK_ALPHA_FIX).sum(axis=2, dtype=np.uint16) > 382
-    if opaque is not None and m.shape == opaque.shape:  # a mask of another size: _check says so
+        mask_file = check_path(mask, "load_scan: mask", fix="an image file or an (h, w) bool array")
+        m = read_photo_rgb(mask_file, "veneer mask", MASK_ALPHA_FIX).sum(axis=2, dtype=np.uint16) > 382
+        if m.shape != rgb.shape[:2]:  # both files named: Veneer's own check knows neither
+            raise WoodcamError(
+                f"veneer {vid!r}: its mask {str(mask_file)!r} is {m.shape[1]}x{m.shape[0]} px and its scan "
+                f"{str(path)!r} {rgb.shape[1]}x{rgb.shape[0]} px; the mask must have the scan's size (one mask "
+                "pixel per scan pixel); resample the mask to the scan")
+    if opaque is not None and m.shape == opaque.shape:  # a mask array of another size: Veneer says so
         m = m & opaque
-    return _check(Veneer(id or Path(path).stem, rgb, ppm, m, str(path)))
+    if m.shape == rgb.shape[:2] and not m.any():
+        # said by what emptied it: 'its mask is empty; check the mask' was said of a scan given
+        # no mask whose pixels are all transparent
+        if mask_file is not None:
+            why = (f"its mask {str(mask_file)!r} has no white pixel" + (" where the scan is opaque"
+                   if opaque is not None and not opaque.all() else "")
+                   + " (white, a mean of R, G and B above half, marks usable wood); paint the usable wood "
+                   "white, or give no mask for the whole sheet")
+        elif mask is not None:
+            why = "its mask array is False everywhere (True marks usable wood)"
+        else:
+            why = (f"every pixel of the scan {str(path)!r} is transparent (a cut-out's background is no "
+                   "wood); give the scan with its wood opaque")
+        raise WoodcamError(f"veneer {vid!r} has zero usable wood: {why}")
+    return _check(Veneer(vid, rgb, ppm, m, str(path)))
 
 
 def mokume_veneers(folder: str | Path, size_mm: float = 50.0) -> list[Veneer]:
