@@ -1043,6 +1043,21 @@ def test_a_sheet_too_small_for_a_patch_and_its_whole_pixel_kerf_is_refused():
         assert len(build_parquetry(target, [v], prm, seams=False).patches) == 1
 
 
+def test_a_run_that_placed_one_patch_says_one_patch():
+    """'placed 1 patches covering 1 of 16 cells' and 'camera: 4 x 4 cells, 56 x 56 mm, 1 patches'
+    (woodcam parquetry camera.png --veneer scan.png:130:half_mask.png, issue 19's walk-through)."""
+    from woodcam.parquetry.output import format_summary, summary
+
+    prm = ParquetryParams(px_per_mm=1.0, patch_mm=10, overlap_mm=0, kerf_mm=1.2, image_size_mm=20)
+    v = Veneer("s14", np.full((14, 14, 3), 0.5, np.float32), 1.0, np.ones((14, 14), bool))
+    with pytest.warns(WoodcamWarning, match="the veneers cannot cover the panel"):
+        run = build_parquetry(np.zeros((20, 20, 3), np.float32), [v], prm, seams=False)
+    assert run.message.startswith("the veneers ran out of free wood: placed 1 patch covering 1 of 4 cells; the "
+                                  "rest of the panel is left empty. "), run.message
+    text = format_summary(summary(run), {})
+    assert text.splitlines()[0] == "target0: 2 x 2 cells, 20 x 20 mm, 1 patch", text
+
+
 @pytest.mark.parametrize("kerf_mm, margin", [(0.0, 0), (0.5, 1), (1.0 - 1e-12, 1), (1.0, 1), (1.0 + 1e-12, 1),
                                              (1.2, 2), (2.0, 2), (2.5, 3)])
 def test_the_size_check_and_the_search_agree_on_the_kerf_at_the_sheet_edge(kerf_mm, margin):

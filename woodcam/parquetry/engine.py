@@ -418,8 +418,10 @@ def build_parquetry(targets: np.ndarray | list[np.ndarray], veneers: list[Veneer
                 bar.update(sum(q.cells ** 2 for q in patches[before:]))
     except _OutOfWood:
         placed = sum(int((p.cells >= 0).sum()) for p in panels)
-        message = (f"the veneers ran out of free wood: placed {len(patches)} patches covering "
-                   f"{placed} of {planned_cells} cells; the rest of the panel is left empty. "
+        n = len(patches)  # 'placed 1 patches covering 1 of 16 cells' of a run that made one
+        message = (f"the veneers ran out of free wood: placed {n} patch{'' if n == 1 else 'es'} covering "
+                   f"{placed} of {planned_cells} cells; the rest of the "
+                   f"{'panel is' if len(panels) == 1 else 'panels are'} left empty. "
                    "Add veneer sheets, make the panel smaller (image_size_mm, --image-size-mm) or use "
                    "larger patches")
     finally:

@@ -246,7 +246,7 @@ def format_summary(summ: dict, problems: dict) -> str:
         # in the message units (--units) too: the panel's size is the one length of the summary
         inch = f" ({say_length(d['size_mm'], sep=' x ')})" if message_unit() != "mm" else ""
         line = (f"{d['name']}: {d['cells'][1]} x {d['cells'][0]} cells, {d['size_mm'][0]:g} x "
-                f"{d['size_mm'][1]:g} mm{inch}, {d['patches']} patches")
+                f"{d['size_mm'][1]:g} mm{inch}, {d['patches']} patch{'' if d['patches'] == 1 else 'es'}")
         if "feature_cost" in d:
             def ssim(key):  # None: the grid is narrower than SSIM's 7 x 7 window
                 return ("n/a (fewer pixels than its 7 x 7 window)" if d[key] is None
