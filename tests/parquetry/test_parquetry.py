@@ -770,6 +770,43 @@ def test_a_bad_job_file_is_one_error_naming_the_entry(job, match, tmp_path):
         read_job(tmp_path / "job.json")
 
 
+_B = {"spec": "builtin:flat-sawn"}
+
+
+@pytest.mark.parametrize("entry, said", [
+    ({"sheets": 0}, "woodcam.blocks[0].sheets must be in [1, 1000] (leaves sliced from the block); got 0; e.g. 2, "
+     "or remove the key for the default, 2"),
+    ({"sheets": 10**6}, "woodcam.blocks[0].sheets must be in [1, 1000]"),
+    ({"thickness_mm": -1}, "woodcam.blocks[0].thickness_mm must be > 0 mm (a leaf's thickness); got -1; remove the "
+     "key for the default"),
+    ({"width_mm": 0}, "woodcam.blocks[0].width_mm must be > 0 mm (a leaf's width); got 0"),
+    ({"kerf_mm": -0.1}, "woodcam.blocks[0].kerf_mm must be >= 0 mm (the saw kerf between leaves); got -0.1"),
+    ({"axis": "w"}, "woodcam.blocks[0].axis must be \"x\", \"y\" or \"z\" (the normal of the slicing planes, block "
+     "frame); got 'w'; remove the key for the default, \"y\""),
+    ({"species": "purple"}, "woodcam.blocks[0].species must be one of the presets oak, "),
+    ({"spec": "builtin:nope"}, "woodcam.blocks[0].spec 'builtin:nope': unknown built-in block 'nope'; choose one "
+     "of: flat-sawn, "),
+    ({"spec": "builtin:flat-sawn:a"}, "woodcam.blocks[0].spec 'builtin:flat-sawn:a': the size must be WxDxH in mm"),
+])
+def test_a_job_files_bad_block_entry_is_said_at_the_door_in_its_keys(entry, said, tmp_path, monkeypatch):
+    """A job file's woodcam.blocks entry was checked when its leaves were cut, in Python's words
+    and without the file: '"sheets": 0' -> 'n_sheets must be an integer >= 1; got 0; e.g. 4',
+    '"species": "purple"' -> '... or species=None for the block's own', '"spec": "builtin:nope"'
+    -> 'unknown built-in block 'nope'; ...' (no key, no file), after the job's scans were read."""
+    path = tmp_path / "job.json"
+    path.write_text(json.dumps({"targets": _T, "woodcam": {"blocks": [{**_B, **entry}]}}))
+    with pytest.raises(WoodcamError) as info:
+        read_job(path)
+    text = str(info.value)
+    assert text.startswith(f"job file {str(path)!r}: {said}"), text
+    assert "species=None" not in text and "n_sheets" not in text, text
+    # a good entry passes the door
+    path.write_text(json.dumps({"targets": _T, "woodcam": {"blocks": [{**_B, "sheets": 3, "species": "walnut",
+                                                                        "axis": "x", "kerf_mm": 0}]}}))
+    (tmp_path / "t.png").touch()
+    assert read_job(path).blocks[0]["sheets"] == 3
+
+
 @pytest.mark.parametrize("job, said", [
     ({"num_source_rotations": "abc"}, "num_source_rotations must be a whole number; got 'abc'; remove the key for "
      "the default, 15"),

@@ -368,6 +368,52 @@ _ENTRY_KEYS = {"source_textures": {"texture", "mask", "id", "scale", "dpi", "px_
 _BLOCK_KEYS = {"spec", "sheets", "width_mm", "height_mm", "thickness_mm", "kerf_mm", "axis", "species", "id"}
 
 
+#: Most leaves a ``woodcam.blocks`` entry may slice, as ``woodcam parquetry --sheets`` (1e6 ran
+#: on, memory growing).
+_MAX_SHEETS = 1000
+
+
+def _check_block_entry(b: dict, at: str) -> None:
+    """A job file's ``woodcam.blocks`` entry (its numbers' types checked) checked at the door in
+    the file's words, ``at`` naming it (``"job file 'job.json': woodcam.blocks[0]"``): the spec's
+    grammar and built-in name (a spec naming no file; files are found by :func:`read_job`), the
+    leaves' ranges, the axis and the species. They were said when the leaves were cut, in
+    Python's words and without the file: '"sheets": 0' as 'n_sheets must be an integer >= 1;
+    got 0; e.g. 4', '"species": "purple"' ending 'or species=None for the block's own',
+    '"spec": "builtin:nope"' as 'unknown built-in block 'nope'; ...'."""
+    spec = b["spec"]
+    if spec_path(str(spec)) is None:
+        from .._specs import parse_spec
+        from ..fields.builtin import check_builtin_name
+
+        try:
+            parsed = parse_spec(str(spec))
+            if parsed.kind == "builtin":
+                check_builtin_name(parsed.source)
+        except WoodcamError as err:
+            said = str(err).removeprefix(f"block spec {spec!r}: ")
+            raise WoodcamError(f"{at}.spec {spec!r}: {said}") from None
+    if "sheets" in b and not 1 <= b["sheets"] <= _MAX_SHEETS:
+        raise WoodcamError(f"{at}.sheets must be in [1, {_MAX_SHEETS}] (leaves sliced from the block); got "
+                           f"{b['sheets']!r}; e.g. 2, or remove the key for the default, 2")
+    for num, rule in (("width_mm", "> 0"), ("height_mm", "> 0"), ("thickness_mm", "> 0"), ("kerf_mm", ">= 0")):
+        v = b.get(num)
+        if v is not None and not (v > 0 if rule == "> 0" else v >= 0):
+            what = {"width_mm": "a leaf's width", "height_mm": "a leaf's height", "thickness_mm": "a leaf's thickness",
+                    "kerf_mm": "the saw kerf between leaves"}[num]
+            raise WoodcamError(f"{at}.{num} must be {rule} mm ({what}); got {v!r}; remove the key for the default")
+    if "axis" in b and b["axis"] not in ("x", "y", "z"):
+        raise WoodcamError(f"{at}.axis must be \"x\", \"y\" or \"z\" (the normal of the slicing planes, block "
+                           f"frame); got {b['axis']!r}; remove the key for the default, \"y\"")
+    if b.get("species") is not None:
+        from ..appearance import SPECIES
+
+        if not isinstance(b["species"], str) or b["species"] not in SPECIES:
+            raise WoodcamError(f"{at}.species must be one of the presets {', '.join(SPECIES)}; got "
+                               f"{b['species']!r}; give one of them ('woodcam species' lists them), or null "
+                               "for the block's own")
+
+
 def _refuse_unknown_keys(where: str, objects: list[tuple[str, dict, set[str]]], why: str) -> None:
     """The one check of a job file's keys: ``objects`` are ``(at, object, known keys)``, ``at``
     the object's place in the file (``""`` at the top, ``"targets[0]."``); the first key, in
@@ -512,6 +558,7 @@ def read_job(path: str | Path) -> ParquetryJob:
                           ("thickness_mm", "float"), ("kerf_mm", "float")):
             if num in b:
                 _check_type(f"{where} woodcam.blocks[{i}].{num}", b[num], kind)
+        _check_block_entry(b, f"{where} woodcam.blocks[{i}]")
     base = p.parent
     names = {f.name for f in fields(ParquetryParams)}
     kw = {}
