@@ -876,6 +876,29 @@ def test_a_job_files_missing_file_is_named_by_its_entry_and_folder(tmp_path, mon
         read_image("nope.png", "target image")
 
 
+def test_a_job_files_image_that_is_a_folder_is_refused_at_the_door(tmp_path):
+    """A job file's target, texture or mask naming a folder was 'target image: cannot read
+    '.../notmok' (Is a directory); check the file's permissions and that its disk or share is
+    readable' once the run read it; a Mokume entry naming a file the same. Now refused as read."""
+    from PIL import Image
+
+    from woodcam.parquetry.job import JobPathError
+
+    (tmp_path / "d").mkdir()
+    Image.new("RGB", (40, 30)).save(tmp_path / "t.png")
+    for entries, said in (
+            ({"targets": [{"filename": "d"}]}, f"targets[0].filename 'd': {str(tmp_path / 'd')!r} is a folder; it "
+             "must be an image file (PNG, JPEG or TIFF)"),
+            ({"source_textures": [{"texture": "d", "dpi": 300}]}, "source_textures[0].texture 'd': "),
+            ({"source_textures": [{"texture": "t.png", "dpi": 300, "mask": "d"}]}, "source_textures[0].mask 'd': "),
+            ({"woodcam": {"mokume": ["t.png"]}}, f"woodcam.mokume[0] 't.png': {str(tmp_path / 't.png')!r} is a file; "
+             "it must be a Mokume sample folder (its A_col.png .. F_col.png)")):
+        (tmp_path / "job.json").write_text(json.dumps({"targets": [{"filename": "t.png"}], **entries}))
+        with pytest.raises(JobPathError) as info:
+            read_job(tmp_path / "job.json")
+        assert str(info.value).startswith(f"job file {str(tmp_path / 'job.json')!r}: {said}"), str(info.value)
+
+
 def test_a_job_file_with_nan_is_refused(tmp_path):
     (tmp_path / "job.json").write_text('{"targets": [{"filename": "t.png"}], "weight_sobel": NaN}')
     with pytest.raises(WoodcamError, match="finite numbers"):

@@ -610,6 +610,14 @@ def read_job(path: str | Path) -> ParquetryJob:
                     "or an absolute one") if not Path(p_).is_absolute() and Path(p_).exists() else ""
             raise JobPathError(f"{where} {key} {s!r}: no such file {_abs(p_)!r} (a job file's paths are "
                                f"relative to its folder){here or '; check the path'}", job=str(p), key=key, path=s)
+        # an image that is a folder was 'cannot read ... (Is a directory); check the file's
+        # permissions' once the run read it; a Mokume sample that is a file the same (a block
+        # spec's path may be either: its opening says)
+        folder = key.startswith("woodcam.mokume")
+        if p_ and not key.startswith("woodcam.blocks") and Path(_abs(p_)).is_dir() != folder:
+            raise JobPathError(f"{where} {key} {s!r}: {_abs(p_)!r} is a {'file' if folder else 'folder'}; it must be "
+                               + ("a Mokume sample folder (its A_col.png .. F_col.png)" if folder else
+                                  "an image file (PNG, JPEG or TIFF)"), job=str(p), key=key, path=s)
 
     # the reference code's id is optional: the file's stem, as for --veneer (a texture without
     # one was a KeyError from the CLI)
