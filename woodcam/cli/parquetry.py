@@ -301,6 +301,46 @@ def _say_job_lengths_in_mm(args, job) -> None:
                       WoodcamWarning, stacklevel=2)
 
 
+#: Share of a target's longer side that the panel's whole patches may cut off unsaid: the
+#: default 360 mm panel (26 patches across the short side) cuts at most 1/39 = 2.6 %.
+_CROP_SAID = 0.05
+
+
+def _cells(aspect: float, short_cells: int) -> int:
+    """Patches along the longer side of a panel of ``short_cells`` for a target of ``aspect``
+    (long / short >= 1): whole ones, rounded down, as :func:`woodcam.parquetry.engine.prepare_target`
+    lays them."""
+    return max(1, int(aspect * short_cells + 1e-6))
+
+
+def _say_target_crop(targets, names, params) -> None:
+    """A WoodcamWarning for each target whose longer side the panel crops by more than
+    :data:`_CROP_SAID`: the panel is whole patches, so the longer side is rounded down and the
+    target cut centrally to it (a 120 x 80 px coffee at --image-size-mm 42 lost 11 % of its width
+    without a word: 4 x 3 patches of 14 mm). Names a nearby --image-size-mm that cuts less, and
+    the crop a user can make to choose what is left out."""
+    n = params.short_cells
+    for img, name in zip(targets, names):
+        h, w = img.shape[:2]
+        aspect = max(h, w) / min(h, w)
+        long_cells = _cells(aspect, n)
+        cut = 1.0 - long_cells / (aspect * n)
+        if cut <= _CROP_SAID:
+            continue
+        side = "width" if w >= h else "height"
+        cols, rows = (long_cells, n) if w >= h else (n, long_cells)
+        each_mm = (aspect * n - long_cells) * params.patch_mm / 2
+        better = sorted((1.0 - _cells(aspect, k) / (aspect * k), abs(k - n), k) for k in range(max(1, n - 3), n + 4)
+                        if k != n)
+        fix = (f"give --image-size-mm {better[0][2] * params.patch_mm:g} ({better[0][0]:.0%} cut), or "
+               if better and better[0][0] < min(cut, _CROP_SAID) else "")
+        warnings.warn(f"{name}: the panel is {cols} x {rows} whole patches of {params.patch_mm:g} mm "
+                      f"({cols * params.patch_mm:g} x {rows * params.patch_mm:g} mm), so {cut:.0%} of the target's "
+                      f"{side} is cut off, {each_mm:.1f} mm of panel at each end (the target is {w} x {h} px); "
+                      f"{fix}crop the target to {cols}:{rows} yourself to choose what is left out",
+                      WoodcamWarning, stacklevel=2)
+
+
 def _default_panel_line(args, params) -> str | None:
     """The printed line that says the panel's size when neither the command line nor a job file
     set it (``--image-size-mm``, ``woodcam.params.image_size_mm``): the paper's 360 mm made
@@ -459,6 +499,7 @@ def run(args) -> int:
     except SheetTooSmallError as err:
         defaulted = {v.id: (no_dpi[v.id], f"{v.rgb.shape[1]} x {v.rgb.shape[0]}") for v in veneers if v.id in no_dpi}
         raise WoodcamError(_sheet_too_small(err, args, job.params, defaulted)) from err
+    _say_target_crop(targets, names, job.params)  # of a run made: an error is said alone
     glb_writer = None
     if not args.no_glb:
         from ..export import export_glb as glb_writer
