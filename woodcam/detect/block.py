@@ -47,7 +47,9 @@ copy was edited since, and refuses both edited since (:func:`_source_or_copy`).
 detects the faces that have a photo but no rings, once, and caches the result in the ``detect``
 folder of woodcam's cache (:mod:`woodcam._cache`: ``$WOODCAM_CACHE_DIR`` or platformdirs' user
 cache), one ``.npz`` keyed by a digest of the photos, the block size, the rule, the detector and
-:data:`DETECT_VERSION`; the user's folder is never written to. In a folder 'block from-photos'
+:data:`DETECT_VERSION`, and each face in an entry of its own as ``rings detect`` caches it (below),
+so a block with one photo retaken detects that face alone; the user's folder is never written to.
+In a folder 'block from-photos'
 made again (its manifest names none of the user's files; its record of the earlier detection
 keeps them), the user's corrected SVGs and edited or named images of a face whose photo is
 unchanged are read in over the detected ones and said, as the next detection keeps them, and
@@ -1041,7 +1043,9 @@ def with_detected_rings(block: Block, rule: BoundaryRule = DEFAULT_RULE, *, cach
         return block
 
     def build():
-        out, msgs = detect_block(block, rule=rule, progress=progress)
+        # each face through its own entry too (as 'rings detect' caches them): keyed by the whole
+        # block alone, one photo retaken detected all six faces afresh in fit, bake and eval
+        out, msgs = detect_block(block, rule=rule, progress=progress, cache=cache)
         return ({n: f for n, f in out.faces.items() if n in out.meta["detection"]["faces"]}, msgs)
 
     if cache:
