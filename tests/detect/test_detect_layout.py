@@ -180,3 +180,23 @@ def test_a_coarse_face_is_no_neighbour_but_the_others_are_still_judged(cube):
     assert set(report.unchecked) == {"front"} and "front" not in report.faces
     assert report.corrections == {"top": "rot90ccw"}
     assert report.faces["top"].edges == 3
+
+
+def test_a_correct_layout_at_a_phone_photos_density_is_not_called_mirrored():
+    """Mokume H11 laid out right, brought up to 768 px a side (15.4 px/mm; 'block from-photos'
+    stores phone photos at up to 10), had its 'front' said to look mirrored top-bottom (+0.18
+    over its layout), and at 500 px from six JPEG phone-style photos too: the edge strip, 0.5-1.5
+    px deep, closed in on the crop line as the density rose. It is now at least STRIP_MM deep
+    (that depth at the 5.12 px/mm the margin was measured on): nothing is flagged, and a face
+    turned 180 degrees is still found, with its fix, as at 256 px."""
+    from woodcam.block.io import read_mokume
+    from woodcam.detect.block import photos_only
+
+    from .test_detect_rings import _mokume
+
+    h11 = _resized(photos_only(read_mokume(_mokume("H11"), (50.0, 50.0, 50.0))), 768)
+    report = check_face_layout(h11)
+    assert report.corrections == {} and report.warnings == [], report.warnings
+    assert len(report.faces) == 6 and max(fl.margin for fl in report.faces.values()) < LAYOUT_MARGIN - 0.05
+    turned = _with(h11, "bottom", np.rot90(h11.faces["bottom"].photo, 2))
+    assert check_face_layout(turned).corrections == {"bottom": "rot180"}

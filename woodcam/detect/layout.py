@@ -8,9 +8,9 @@ turned 90/180 degrees breaks that on all its edges at once, and on a cube the as
 
 For each pair of faces meeting at an edge, each face's image (its ring map, or its photo's
 luminance: :func:`check_face_layout`) is read along a thin strip beside the shared edge
-(:data:`STRIP_PX`, mapped by :func:`woodcam.frames.block_to_pixel`) into a 1-D profile over mm
-along the edge; the two profiles are band-passed and scored by their normalised
-cross-correlation, the best within +-:data:`SHIFT_MM`.
+(:data:`STRIP_PX`, at least :data:`STRIP_MM`, mapped by :func:`woodcam.frames.block_to_pixel`)
+into a 1-D profile over mm along the edge; the two profiles are band-passed and scored by their
+normalised cross-correlation, the best within +-:data:`SHIFT_MM`.
 A face's score is the mean over its edges. Each face is scored as laid out and in the other
 dihedral variants (turned 90/180/270 degrees, mirrored; a non-square face only those keeping its
 shape), its neighbours as laid out; :func:`check_face_layout` says which face would fit better
@@ -32,6 +32,15 @@ from .rings import luminance
 #: off the outermost pixels of a crop, yet near enough that a ring crossing the edge obliquely
 #: has not moved far along it (measured: README "From photos alone").
 STRIP_PX = (0.5, 1.5)
+#: ... and at least these depths (mm): STRIP_PX on the 5.12 px/mm Mokume faces the margin was
+#: measured on. In pixels alone the strip closed in on the crop line as the density rose, and
+#: correct layouts drifted to false alarms: Mokume H11 resized to 500 and 768 px a side
+#: (10 and 15.4 px/mm; 10 is what 'block from-photos' stores a phone photo at) scored front
+#: flipped top-bottom +0.14 and +0.18 over its layout (flagged at 768, and at 500 from six
+#: JPEG phone-style photos), and found 10 and 9 of its 18 wrong layouts (13 at 256 px). At
+#: these depths both samples score as at 256 px at every density: none flagged, CN03 16 and
+#: H11 13 of 18 wrong layouts found at 256, 500 and 768 px.
+STRIP_MM = (0.5 / 5.12, 1.5 / 5.12)
 #: Largest shift (mm) between two faces' profiles along an edge that still counts as meeting:
 #: the strip depth times an oblique ring's slope, and a photo cropped a little off.
 SHIFT_MM = 1.0
@@ -178,7 +187,8 @@ def _face_signal(face, detected: bool) -> tuple[np.ndarray, str] | None:
 
 def _strip_points(a: FaceName, b: FaceName, size: np.ndarray, shape) -> np.ndarray:
     """Points (len(STRIP_PX), n, 3) mm inside face ``a`` (image ``shape``) beside the edge where it
-    meets face ``b``: the edge, sampled every :data:`STEP_MM` along it, moved away from ``b``."""
+    meets face ``b``: the edge, sampled every :data:`STEP_MM` along it, moved away from ``b`` by
+    :data:`STRIP_PX` pixels of ``a``, at least :data:`STRIP_MM`."""
     ia, ib = FACE_AXIS[a], FACE_AXIS[b]
     k = 3 - ia - ib                      # the axis the edge runs along
     t = np.arange(0.5 * STEP_MM, size[k], STEP_MM)
@@ -190,7 +200,8 @@ def _strip_points(a: FaceName, b: FaceName, size: np.ndarray, shape) -> np.ndarr
     # pixels per mm across the edge, from the face's own pixel mapping
     px_per_mm = np.hypot(*np.subtract(block_to_pixel(a, p[0] + inward, shape, size),
                                       block_to_pixel(a, p[0], shape, size)))
-    return p[None] + (np.asarray(STRIP_PX) / px_per_mm)[:, None, None] * inward
+    depth_mm = np.maximum(np.asarray(STRIP_PX) / px_per_mm, STRIP_MM)
+    return p[None] + depth_mm[:, None, None] * inward
 
 
 def _profile(image: np.ndarray, face: FaceName, strip: np.ndarray, size: np.ndarray) -> np.ndarray:
