@@ -403,3 +403,36 @@ def test_the_filter_bank_is_built_a_scale_at_a_time():
     finally:
         tracemalloc.stop()
     assert peak < 950 * photo.shape[0] * photo.shape[1], f"{peak / photo.shape[0] / photo.shape[1]:.0f} B a pixel"
+
+
+@pytest.mark.parametrize("shape, sigma", [((64, 48), 17.0), ((256, 256), 128.0), ((37, 500), 250.0),
+                                          ((300, 200), 60.0), ((20, 30), 40.0), ((64, 48), 3.0)])
+def test_the_wide_gaussians_are_scipys_bit_for_bit(shape, sigma):
+    """The detector's widest blurs run through the FFT (_gaussian_reflect); each must equal
+    scipy.ndimage.gaussian_filter(mode="reflect") to the last bit, so detections, their caches
+    and DETECT_VERSION are unchanged: kernels longer than the image (reflected again and again),
+    non-square images, and the narrow ones scipy still does."""
+    from scipy import ndimage
+
+    from woodcam.detect import rings
+
+    x = np.random.default_rng(7).normal(size=shape).astype(np.float32) ** 2  # x * x in _normalise
+    got = rings._gaussian_reflect(x, sigma)
+    assert got.dtype == np.float32 and np.array_equal(got, ndimage.gaussian_filter(x, sigma, mode="reflect"))
+
+
+def test_no_wide_gaussian_is_filtered_tap_by_tap(monkeypatch):
+    """A 256^2 face spent 0.2 s of its 0.45 s in scipy's direct Gaussian passes of sigma 128 px
+    (1025 taps, the illumination flattening) and 50 px (the edge vote), a 500^2 face 1.4 s of
+    3 s (2001 taps); through the FFT they take 0.02 s and 0.12 s. No Gaussian wider than
+    FFT_GAUSSIAN_SIGMA_PX reaches scipy's direct filter now."""
+    from scipy import ndimage
+
+    from woodcam.detect import rings
+
+    photo, _ = _line_face(n=256)
+    real, sigmas = ndimage.gaussian_filter, []
+    monkeypatch.setattr(ndimage, "gaussian_filter",
+                        lambda a, sigma, *args, **kw: sigmas.append(float(np.max(sigma))) or real(a, sigma, *args, **kw))
+    found = detect_rings(photo)
+    assert found.traces and sigmas and max(sigmas) <= rings.FFT_GAUSSIAN_SIGMA_PX, sigmas

@@ -255,19 +255,56 @@ def luminance(photo: np.ndarray) -> np.ndarray:
     return (a.astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)) / scale
 
 
+#: Gaussians wider than this (sigma, px) run through the FFT (:func:`_gaussian_reflect`): the
+#: direct 1-D passes cost (8 sigma + 1) taps a pixel, the FFT a few log n. Crossover measured
+#: on 256^2 and 1000x700 images at sigma 12-20 px.
+FFT_GAUSSIAN_SIGMA_PX = 16.0
+
+
+def _gaussian_reflect(img: np.ndarray, sigma: float) -> np.ndarray:
+    """``scipy.ndimage.gaussian_filter(img, sigma, mode="reflect")`` of a 2-D ``img`` (float32 in,
+    float32 out), through the FFT when ``sigma`` exceeds :data:`FFT_GAUSSIAN_SIGMA_PX` (other
+    dtypes, and narrower sigmas, by scipy itself).
+
+    The detector's widest blurs (the illumination flattening at sigma up to half the face, the
+    edge vote at two ring spacings) took 40-45 % of a face's time: 0.2 s of 0.45 s on a 256^2
+    face, 1.4 s of 3 s on a 500^2 one, in 1025- and 2001-tap passes. Reflected, each line is
+    periodic with period 2n (``abc|cba``), so a pass is a circular convolution of that period with
+    the truncated kernel (``truncate=4``, normalised, as scipy builds it) folded into it. Each pass
+    is computed in float64 and stored as float32, as scipy's are, so the result is scipy's: equal
+    bit for bit on the 12 Mokume faces, synthetic faces and random images tried (DETECT_VERSION
+    unchanged)."""
+    from scipy import ndimage
+
+    out = np.asarray(img)
+    if sigma <= FFT_GAUSSIAN_SIGMA_PX or out.dtype != np.float32 or out.ndim != 2:
+        return ndimage.gaussian_filter(out, sigma, mode="reflect")
+    radius = int(4.0 * float(sigma) + 0.5)
+    k = np.arange(-radius, radius + 1)
+    weights = np.exp(-0.5 / float(sigma) ** 2 * k.astype(np.float64) ** 2)
+    weights /= weights.sum()
+    for axis in (0, 1):  # scipy's order: the float32 rounding between passes is the same
+        n = out.shape[axis]
+        folded = np.zeros(2 * n)
+        np.add.at(folded, k % (2 * n), weights)
+        line = np.concatenate([out, np.flip(out, axis)], axis=axis).astype(np.float64)
+        spec = np.fft.rfft(line, axis=axis) * np.expand_dims(np.fft.rfft(folded), 1 - axis)
+        out = np.take(np.fft.irfft(spec, n=2 * n, axis=axis), np.arange(n), axis=axis).astype(np.float32)
+    return out
+
+
 def _normalise(lum: np.ndarray, sigma: float) -> np.ndarray:
     """Flatten the illumination (a fitted quadratic surface, then a Gaussian of ``sigma`` px) and
     divide by the local RMS contrast (Gaussian, ``sigma`` px). The quadratic takes out lighting
     gradients and vignetting, which the Gaussian alone leaves as ramps along the borders."""
-    from scipy import ndimage
 
     h, w = lum.shape
     rr, cc = np.meshgrid(np.linspace(-1, 1, h), np.linspace(-1, 1, w), indexing="ij")
     basis = np.stack([np.ones_like(rr), rr, cc, rr * rr, rr * cc, cc * cc], axis=-1).reshape(-1, 6)
     coef = np.linalg.lstsq(basis[::7], lum.reshape(-1)[::7], rcond=None)[0]
     lum = lum - (basis @ coef).reshape(h, w).astype(np.float32)
-    x = lum - ndimage.gaussian_filter(lum, sigma, mode="reflect")
-    rms = np.sqrt(ndimage.gaussian_filter(x * x, sigma, mode="reflect"))
+    x = lum - _gaussian_reflect(lum, sigma)
+    rms = np.sqrt(_gaussian_reflect(x * x, sigma))
     return x / (rms + 1e-3 + 0.05 * float(np.median(rms)))
 
 
@@ -657,17 +694,16 @@ def _vote(steep_f: np.ndarray, steep_r: np.ndarray, r: np.ndarray, c: np.ndarray
     along the normal) is the steeper: the mean steepness of each edge (``steep_f``, ``steep_r``
     (n,)) over :data:`VOTE_SCALE_WAVELENGTHS` ring spacings round it. Which edge is sharp can
     change within a face (the pith inside it, a knot), so the vote is local, not per face."""
-    from scipy import ndimage
 
     sigma = VOTE_SCALE_WAVELENGTHS * float(np.median(lam[r, c]))
     count = np.zeros(shape, np.float32)
     np.add.at(count, (r, c), 1.0)
-    count = ndimage.gaussian_filter(count, sigma) + 1e-6
+    count = _gaussian_reflect(count, sigma) + 1e-6
     votes = []
     for vals in (steep_f, steep_r):
         acc = np.zeros(shape, np.float32)
         np.add.at(acc, (r, c), vals.astype(np.float32))
-        votes.append((ndimage.gaussian_filter(acc, sigma) / count)[r, c])
+        votes.append((_gaussian_reflect(acc, sigma) / count)[r, c])
     return votes[1] >= votes[0]
 
 
