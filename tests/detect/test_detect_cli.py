@@ -330,6 +330,35 @@ def test_rings_detect_into_a_folder_with_an_unreadable_manifest_writes_over_it(s
         assert all((out / f"{n}_traces.svg").is_file() for n in b.faces)
 
 
+def test_rings_show_names_a_face_with_no_rings(synth_photos, tmp_path, capsys, monkeypatch):
+    """A face detection found no rings on (warned at 'rings detect') was drawn by 'rings show' as
+    its bare photo under its plain name, like any face, and 'wrote check.png' said nothing of it:
+    the check picture let an empty face pass for one not looked at. Its label now reads
+    'back (F): no rings' and the line names it with the SVG to trace it in."""
+    from woodcam.block.render import label_face
+    from woodcam.detect.show import face_picture
+
+    monkeypatch.setenv("WOODCAM_CACHE_DIR", str(tmp_path / "cache"))
+    photos = _copy(synth_photos, tmp_path / "photos", skip=("back",))
+    rng = np.random.default_rng(3)  # smooth end grain: a slight gradient and sensor noise, no rings
+    plain = 150 + 10 * np.linspace(0, 1, 160)[:, None, None] + rng.normal(0, 3, (160, 160, 3))
+    Image.fromarray(np.clip(plain, 0, 255).astype(np.uint8)).save(photos / "back.png")
+    blk = tmp_path / "blk"
+    assert _run(capsys, "block", "from-photos", photos, "--size-mm", "50", "--out", blk)[0] == 0
+    rc, _out, err = _run(capsys, "rings", "detect", blk, "--out", blk)
+    assert rc == 0 and "face 'back': no rings found" in err, err
+    rc, out, err = _run(capsys, "rings", "show", blk, "--out", tmp_path / "check.png")
+    assert rc == 0, err
+    assert out.strip() == (f"wrote {tmp_path / 'check.png'} (no rings on back: trace them in "
+                           f"{blk / 'back_traces.svg'})"), out
+    b = read_block(blk)
+    back, front = b.faces["back"], b.faces["front"]
+    zoomed = np.asarray(Image.fromarray(back.photo).resize((320, 320), Image.NEAREST))
+    assert np.array_equal(face_picture(back), label_face(zoomed, "back", "no rings"))
+    assert front.traces and not np.array_equal(face_picture(front)[:40], label_face(
+        np.asarray(Image.fromarray(front.photo).resize((320, 320), Image.NEAREST)), "front", "no rings")[:40])
+
+
 def test_the_detection_cache_stays_in_the_cache_whatever_the_block_is_named(synth_photos, tmp_path, monkeypatch):
     """A block named "../../escaped/evil" cached its detection outside the cache folder, and a
     name of 250 characters failed with 'File name too long'."""

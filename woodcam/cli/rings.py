@@ -129,7 +129,7 @@ def run(args) -> int:
         from .._atomic import atomic_path
         from ..block.io import MANIFEST, read_block_folder
         from ..detect.block import with_detected_rings
-        from ..detect.show import rings_picture
+        from ..detect.show import ringless, rings_picture
 
         folder = Path(args.block)
         refs = None
@@ -152,6 +152,10 @@ def run(args) -> int:
         pic = rings_picture(block, zoom=args.zoom, references=refs)
         with atomic_path(args.out, mkdir=True) as tmp:
             Image.fromarray(np.asarray(pic)).save(tmp, format="PNG")
-        print(f"wrote {args.out}")
+        # a face detection found no rings on was drawn as its bare photo, without a word
+        bare = [n for n, f in block.faces.items() if ringless(f)]
+        fix = (f": trace them in {', '.join(str(folder / f'{n}_traces.svg') for n in bare)}"
+               if refs is None and folder.is_dir() else "")  # a block folder: its SVGs are read back
+        print(f"wrote {args.out}" + (f" (no rings on {', '.join(bare)}{fix})" if bare else ""))
         return 0
     raise AssertionError(args.rings_command)

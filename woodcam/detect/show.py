@@ -7,7 +7,8 @@ Drawn on each photo: the ring traces (red; pieces the detector linked into one r
 shows as a colour jumping between lines), the knot masks' outlines (yellow) and, when a
 reference ring map is given (e.g. Mokume's U-Net map), its ridge (cyan dots); the face's name
 and Mokume letter at its top-left corner (:func:`woodcam.block.render.label_face`); a face the
-block has no photo of is a labelled blank (``back (F): no photo``).
+block has no photo of is a labelled blank (``back (F): no photo``), and a photo with no ring traced
+or mapped on it says so (``back (F): no rings``, :func:`ringless`).
 """
 
 from __future__ import annotations
@@ -25,9 +26,15 @@ KNOT_RGB = (255, 220, 0)
 REFERENCE_RGB = (0, 230, 255)
 
 
+def ringless(face) -> bool:
+    """Whether ``face`` has a photo but neither ring traces nor a ring map: detection found no
+    rings on it (it warned), and its picture showed the bare photo, like a face not yet looked at."""
+    return face.photo is not None and not face.traces and face.ring_map is None
+
+
 def face_picture(face, zoom: int = 2, reference_map: np.ndarray | None = None) -> np.ndarray:
     """``(h * zoom, w * zoom, 3)`` uint8: one face's photo with its traces, knots and reference,
-    named at its top-left corner."""
+    named at its top-left corner (``: no rings`` after the name when :func:`ringless`)."""
     from PIL import Image, ImageDraw
     from scipy import ndimage
 
@@ -53,7 +60,7 @@ def face_picture(face, zoom: int = 2, reference_map: np.ndarray | None = None) -
         xy = ((t.points_px[:, ::-1] + 0.5) * zoom).ravel().tolist()
         rgb = TRACE_RGB if t.ring is None else RING_RGBS[t.ring % len(RING_RGBS)]
         draw.line(xy, fill=rgb, width=max(1, zoom // 2))
-    return label_face(np.asarray(im), face.name)
+    return label_face(np.asarray(im), face.name, "no rings" if ringless(face) else "")
 
 
 def rings_picture(block, zoom: int = 2, references: dict | None = None) -> np.ndarray:
