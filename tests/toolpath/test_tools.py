@@ -126,8 +126,9 @@ def test_new_profiles_specs_and_tables(tmp_path):
                  '"snub_diameter": 2, "length": 2}, "4": {"shape": "ballnose", "diameter": 3}}}')
     with pytest.warns(WoodcamWarning, match=r"tool 4 \(ballnose\) gives no \"length\""):
         tools = load_tool_table(j)
-    # a cylindrical tool's length is its cutting (flute) length: 1 inch
-    assert tools[1] == FlatEndMill(6.35, flute_length_mm=25.4) and tools[4] == BallEndMill(3)
+    # a cylindrical tool's length is its cutting (flute) length: 1 inch; none: CAMotics' 10 mm
+    assert tools[1] == FlatEndMill(6.35, flute_length_mm=25.4)
+    assert tools[4] == BallEndMill(3, flute_length_mm=10)
     assert tools[2] == VBit(10, angle_deg=90, flute_length_mm=5)
     assert tools[3] == SnubNoseVBit(6, angle_deg=90, tip_diameter_mm=2, flute_length_mm=2)
     j.write_text('{"tools": {"1": {"shape": "spheroid", "diameter": 3}}}')
@@ -179,22 +180,32 @@ def test_a_camotics_entry_number_names_its_tool(tmp_path):
 
 
 def test_a_camotics_tool_without_length_is_said(tmp_path):
-    """Without "length" CAMotics takes 10 mm; woodcam gives a cylindrical or ball-nose tool no
-    flute length (no limit) and refuses a cone. Neither was said: the tool's cuts past its
-    flutes then go unwarned, so one warning names the tools without a length; the cone's
-    refusal says "length" is missing rather than "got nan"."""
+    """Without "length" CAMotics takes 10 mm (Tool's constructor: ToolTable::read builds a metric
+    Tool, then Tool::read leaves its length alone): woodcam gave a cylindrical or ball-nose tool
+    no flute length (no limit: cuts past its flutes went unwarned) and refused a cone, so the
+    tool it simulated was not the one CAMotics cuts with. It now takes 10 mm for every shape,
+    in mm for an imperial entry too (not 10 in, not 1 in), a cone's angle from it, and one
+    warning names the tools and the length taken."""
     j = tmp_path / "tools.json"
     j.write_text('{"1": {"shape": "cylindrical", "diameter": 3}, "2": {"shape": "ballnose",'
-                 ' "diameter": 6}, "5": {"shape": "ballnose", "diameter": 6, "length": 20}}')
-    with pytest.warns(WoodcamWarning, match=r'tools 1 \(cylindrical\), 2 \(ballnose\) give no '
-                      r'"length", so the flute length is unknown.*cannot be warned') as caught:
+                 ' "diameter": 6, "units": "imperial"}, "5": {"shape": "ballnose", "diameter": 6,'
+                 ' "length": 20}, "7": {"number": 8, "shape": "cone", "diameter": 20}}')
+    with pytest.warns(WoodcamWarning, match=r'tools 1 \(cylindrical\), 2 \(ballnose\), 8 \(conical, '
+                      r"key '7'\) give no \"length\": each is taken as 10 mm long, as CAMotics takes "
+                      r"it .*in mm whatever the entry's units") as caught:
         tools = load_camotics_tools(j)
-    assert len(caught) == 1 and tools[1] == FlatEndMill(3) and tools[2] == BallEndMill(6)
+    assert len(caught) == 1
+    assert tools[1] == FlatEndMill(3, flute_length_mm=10)
+    assert tools[2] == BallEndMill(6 * 25.4, flute_length_mm=10)  # the 10 mm is not scaled
+    assert tools[5] == BallEndMill(6, flute_length_mm=20)
+    # CAMotics' cone of diameter 20 and length 10: 2 atan(10 / 10) = 90 degrees
+    assert tools[8] == VBit(20, angle_deg=90, flute_length_mm=10)
+    j.write_text('{"1": {"shape": "snubnose", "diameter": 12, "snub_diameter": 2}}')
+    with pytest.warns(WoodcamWarning, match=r'tool 1 \(snubnose\) gives no "length": it is taken as 10 mm'):
+        assert load_camotics_tools(j)[1] == SnubNoseVBit(12, angle_deg=2 * math.degrees(math.atan(0.5)),
+                                                         tip_diameter_mm=2, flute_length_mm=10)
     j.write_text('{"1": {"shape": "cylindrical", "diameter": 3, "length": 12}}')
     load_camotics_tools(j)  # a length given: no word (filterwarnings = error)
-    j.write_text('{"1": {"shape": "cone", "diameter": 6}}')
-    with pytest.raises(WoodcamError, match='a conical tool needs "length" .*it has none'):
-        load_camotics_tools(j)
 
 
 def test_a_v_bit_cutting_past_its_camotics_cone_is_warned(tmp_path):

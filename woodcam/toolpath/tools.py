@@ -625,6 +625,11 @@ _CAMOTICS_SHAPES = ("cylindrical", "ballnose", "conical", "snubnose")
 _CAMOTICS_ALIASES = {"cylinder": "cylindrical", "cone": "conical"}
 #: CAMotics' units (its Units names and aliases mm and inch, any case) -> mm per table unit.
 _CAMOTICS_UNITS = {"metric": 1.0, "mm": 1.0, "imperial": 25.4, "inch": 25.4}
+#: mm: the length CAMotics gives a tool table entry without "length" (Tool's constructor,
+#: setLength(10) for the metric tool ToolTable::read builds before Tool::read reads the entry;
+#: an imperial entry keeps it: 10 mm, not 10 in or 1 in). A cylindrical or ball-nose tool's
+#: cutting length, a cone's height (with the diameter, its angle).
+CAMOTICS_DEFAULT_LENGTH_MM = 10.0
 
 
 def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
@@ -635,14 +640,15 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
     ``cone`` as aliases; no units: metric). CAMotics defines a cone by its diameter and the
     length of its conical part: included angle ``2 atan((D - d) / 2 / L)``. ``length`` is the
     cutter's length from its tip, all CAMotics' tool body: woodcam's ``flute_length_mm`` (a cut
-    deeper is warned: the shank rubs), for a cone too; without it (CAMotics then takes 10 mm)
-    a cylindrical or ball-nose tool carries no reach, said in one
-    :class:`~woodcam.errors.WoodcamWarning` naming those tools (no cut can then be warned as
-    deeper than its flutes), and a cone is refused. An entry's ``"number"`` is its tool number,
-    as in CAMotics (Tool::read, then ToolTable::set files it under that number), the key
-    without one; two entries on one number are refused (CAMotics keeps the later one without a
-    word). Lengths in the table's units; woodcam's tools in mm. ``path``: the ``.camotics``
-    project or ``.json`` file."""
+    deeper is warned: the shank rubs), for a cone too; without it the tool takes CAMotics' own
+    default, :data:`CAMOTICS_DEFAULT_LENGTH_MM` (10 mm, in mm whatever the entry's units: its
+    ToolTable::read builds a metric Tool, whose constructor sets it, before Tool::read reads the
+    entry's units), a cone's angle from it too, said in one
+    :class:`~woodcam.errors.WoodcamWarning` naming those tools and the length. An entry's
+    ``"number"`` is its tool number, as in CAMotics (Tool::read, then ToolTable::set files it
+    under that number), the key without one; two entries on one number are refused (CAMotics
+    keeps the later one without a word). Lengths in the table's units; woodcam's tools in mm.
+    ``path``: the ``.camotics`` project or ``.json`` file."""
     import json
 
     path = Path(path)
@@ -686,24 +692,23 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
                                f"not one of {_CAMOTICS_SHAPES}")
         num = lambda k, default=math.nan: _number(e.get(k, default), path, key, k) * scale  # noqa: E731
         d = num("diameter")
-        # CAMotics' "length" of a cylindrical or ball-nose tool is its cutting length
-        flute = num("length", 0.0)
-        reach = {"flute_length_mm": flute} if flute > 0 else {}
-        if "length" not in e and shape in ("cylindrical", "ballnose"):
+        # CAMotics' "length" of a cylindrical or ball-nose tool is its cutting length; without
+        # one, CAMotics cuts with its default (in mm, not scaled by the entry's units), so woodcam
+        # simulates the tool CAMotics does rather than one of unlimited reach or none at all
+        if "length" in e:
+            flute = num("length")
+        else:
+            flute = CAMOTICS_DEFAULT_LENGTH_MM
             no_length.append(f"{number} ({shape})" if str(number) == str(key) else
                              f"{number} ({shape}, key {key!r})")
+        reach = {"flute_length_mm": flute} if flute > 0 else {}
         if shape == "cylindrical":
             tool: Tool = FlatEndMill(d, **reach)
         elif shape == "ballnose":
             tool = BallEndMill(d, **reach)
         else:
             tip = num("snub_diameter", 0.0) if shape == "snubnose" else 0.0
-            if "length" not in e:  # CAMotics would take 10 mm: a cone's angle is not guessed
-                raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: a {shape} tool "
-                                   "needs \"length\" (the cone's height, which with the diameter "
-                                   "gives its angle), and it has none (CAMotics takes 10 mm); add "
-                                   "\"length\": L in the table's units")
-            length = num("length")
+            length = flute  # the cone's height: the entry's, else CAMotics' default (warned)
             if not length > 0:
                 raise WoodcamError(f"load_camotics_tools: {path}: tool {key}: a {shape} tool "
                                    f"needs length > 0 (the cone's height), got {length!r}")
@@ -718,10 +723,12 @@ def load_camotics_tools(path: PathLike) -> dict[int, Tool]:
 
         warnings.warn(
             f"load_camotics_tools: {path}: tool{'s' if len(no_length) > 1 else ''} "
-            f"{', '.join(no_length)} give{'' if len(no_length) > 1 else 's'} no \"length\", so "
-            "the flute length is unknown and a cut deeper than the flutes (the shank rubbing) "
-            "cannot be warned (CAMotics takes 10 mm); add \"length\": L, the cutting length in "
-            "the table's units", WoodcamWarning, stacklevel=2)
+            f"{', '.join(no_length)} give{'' if len(no_length) > 1 else 's'} no \"length\": "
+            f"{'each' if len(no_length) > 1 else 'it'} is taken as {CAMOTICS_DEFAULT_LENGTH_MM:g} mm "
+            "long, as CAMotics takes it (its default, in mm whatever the entry's units; a cone's "
+            "angle follows from it), the length past which a cut is warned (the shank rubbing); "
+            "add \"length\": L, the cutting length (a cone's height) in the table's units",
+            WoodcamWarning, stacklevel=2)
     return out
 
 
