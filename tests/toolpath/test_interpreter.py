@@ -185,7 +185,8 @@ def test_endsub_with_a_value_returns_it_as_linuxcnc():
     for name in ("_value", "_value_returned"):
         with pytest.raises(GcodeError, match=f"#<{name}> is a read-only"):
             _ends(f"#<{name}> = 3\nM2\n")
-    with pytest.raises(GcodeError, match=r"endsub needs a \[value\]"):
+    with pytest.raises(GcodeError, match=r"line 2: 'o1 endsub5': text after o1 endsub \(LinuxCNC: "
+                       r"'Unexpected character after O-word'\)"):
         _ends("o1 sub\no1 endsub 5\no1 call\nM2\n")
     with pytest.raises(GcodeError, match="division by zero"):
         _ends("o1 sub\no1 endsub [1/0]\nM2\n")
@@ -1378,3 +1379,60 @@ def test_a_do_loop_reached_while_skipping_is_run_into_with_a_warning():
     with pytest.raises(GcodeError, match="duplicate O-word label") as e:
         _ends("o1 if [0]\no1 if [1]\no1 endif\no1 endif\nM2\n")
     assert e.value.line == 2
+
+
+#: (program, end points of its moves from the origin, the line refused or None), as rs274 -g
+#: (LinuxCNC 2.9) runs them: the o-word sub lines it reads only when the program reaches them
+#: or passes over their definition (test_sub_lines_are_refused_where_rs274_refuses_them, in
+#: test_linuxcnc_oracle.py, checks the table against rs274 itself).
+SUB_LINE_PROGRAMS = [
+    # text after 'o100 sub': refused as the definition is passed over ...
+    ("o100 sub G1 X9\nG1 X#1 F100\no100 endsub\nG1 X2 F100\nM2\n", [], 1),
+    # ... not where a call finds it searching forward
+    ("G1 X1 F100\no100 call [2]\nG1 X3\nM2\no100 sub [3]\nG1 X#1\no100 endsub\n",
+     [(1, 0, 0), (2, 0, 0), (3, 0, 0)], None),
+    # text after an endsub passed over: its [value] is read, the rest left; refused on return
+    ("o100 sub\nG1 X#1 F100\no100 endsub [2] G1 X5\nG1 X#<_value> F100\n"
+     "G1 Y[#<_value_returned>+4]\nM2\n", [(2, 0, 0), (2, 5, 0)], None),
+    ("o100 sub\nG1 X#1 F100\no100 endsub G1 X5\nG1 X[#<_value>+1] F100\n"
+     "G1 Y[#<_value_returned>+4]\nM2\n", [(1, 0, 0), (1, 4, 0)], None),
+    ("o100 sub\nG1 X#1 F100\no100 endsub [2] G1 X5\nG1 Y1 F100\no100 call [3]\nM2\n",
+     [(0, 1, 0), (3, 1, 0)], 3),
+    ("o100 sub\nG1 X#1 F100\no100 endsub ]\nG1 Y1 F100\no100 call [3]\nM2\n",
+     [(0, 1, 0), (3, 1, 0)], 3),
+    # an endsub or return outside every definition: refused only when reached
+    ("G1 X1 F100\nM2\no100 endsub\n", [(1, 0, 0)], None),
+    ("G1 X1 F100\no1 if [0]\no100 return\no1 endif\nG1 X2\nM2\n", [(1, 0, 0), (2, 0, 0)], None),
+    ("G1 X1 F100\no100 endsub\nG1 X2\nM2\n", [(1, 0, 0)], 2),
+    ("G1 X1 F100\no1 if [1]\no100 return\no1 endif\nG1 X2\nM2\n", [(1, 0, 0)], 3),
+    # a sub defined inside another: refused as the outer one is passed over, at the inner line;
+    # a forward call runs through it and returns at its endsub (X4 never cut)
+    ("G1 X1 F100\no100 sub\no101 sub\no101 endsub\no100 endsub\nG1 X2\nM2\n", [(1, 0, 0)], 3),
+    ("G1 X1 F100\nM2\no100 sub\no101 sub\no101 endsub\no100 endsub\n", [(1, 0, 0)], None),
+    ("G1 X1 F100\no100 call [2]\nG1 X3\nM2\no100 sub\nG1 X#1\no101 sub\nG1 X9\no101 endsub\n"
+     "G1 X4\no100 endsub\n", [(1, 0, 0), (2, 0, 0), (9, 0, 0), (3, 0, 0)], None),
+    # a sub never closed: nothing after M2 is read; reached, refused at its line (rs274 says
+    # 'File ended ...' at the file's last, the line it got to looking for the endsub)
+    ("G1 X1 F100\nM2\no100 sub\nG1 X2\n", [(1, 0, 0)], None),
+    ("G1 X1 F100\no100 sub\nG1 X2\nM2\n", [(1, 0, 0)], 2),
+]
+
+
+@pytest.mark.parametrize("text, ends, line", SUB_LINE_PROGRAMS)
+def test_sub_lines_are_refused_where_linuxcnc_refuses_them(text, ends, line):
+    """LinuxCNC reads an o-word sub's lines when the program reaches them or passes over the
+    definition, and runs the moves before: woodcam refused an endsub or return outside a
+    definition, a sub inside another and a sub never closed before running any line, also
+    after M2 or in a branch not taken, where LinuxCNC never reads them; refused text after an
+    endsub passed over, which LinuxCNC leaves unread until a call returns there; and ran text
+    after 'o100 sub', which LinuxCNC refuses ('Unexpected character after O-word'). Now the
+    moves before a refusal are cut and the refused line is LinuxCNC's (rs274 quotes it)."""
+    interp = Interpreter(text, start_mm=(0, 0, 0))
+    if line is None:
+        moves, _ = interp.run()
+    else:
+        with pytest.raises(GcodeError) as e:
+            interp.run()
+        assert e.value.line == line, e.value
+        moves = interp.moves
+    assert [m[2] for m in moves] == ends

@@ -19,6 +19,7 @@ from woodcam.toolpath.linuxcnc import (NO_END, canonical, compare_canonical, lin
 
 from .gcode_fuzz import oword_program, program
 from .test_gcode import SUB_SLOTS, check_until_line_counts_a_call_s_moves_at_its_line
+from .test_interpreter import SUB_LINE_PROGRAMS
 
 REPO = Path(__file__).resolve().parents[2]
 CORPUS = sorted((REPO / "toolpaths" / "corpus").glob("*.*[!y]")) + sorted(
@@ -1226,3 +1227,30 @@ def test_a_blank_file_says_rs274s_end_of_file_message_with_both_interpreters(tmp
     if "%" not in text:  # (one opened with '%' wants the closing one: 'no percent sign')
         assert read_gcode(text + "(c)\n", interpreter="linuxcnc").warnings[-1].endswith(
             "File ended with no percent sign or program end")
+
+
+@pytest.mark.skipif(not RS274.exists(), reason=f"{RS274} (LinuxCNC's standalone interpreter, "
+                    "linuxcnc-uspace) is not installed")
+@pytest.mark.parametrize("text, ends, line", SUB_LINE_PROGRAMS)
+def test_sub_lines_are_refused_where_rs274_refuses_them(tmp_path, text, ends, line):
+    """The known answers of test_interpreter.SUB_LINE_PROGRAMS are rs274's: the same moves
+    before any refusal, and woodcam refuses the line rs274 quotes with its error, or for a sub
+    never closed its sub line, where rs274 quotes the file's last line and says 'File ended
+    with no percent sign or program end' (which woodcam's message quotes)."""
+    path = tmp_path / "sub.ngc"
+    path.write_text(text)
+    r = subprocess.run([str(RS274), "-g", str(path)], capture_output=True, text=True,
+                       timeout=60, cwd=tmp_path)
+    theirs = [tuple(float(v) for v in ln.split("(")[1].split(",")[:3])
+              for ln in r.stdout.splitlines() if "STRAIGHT_" in ln]
+    said = [ln for ln in r.stderr.splitlines() if ln != "executing"]
+    assert theirs == [tuple(map(float, e)) for e in ends]
+    assert bool(said) == (line is not None), said
+    if line is not None:
+        with pytest.raises(GcodeError) as e:
+            Interpreter(text, start_mm=(0, 0, 0)).run()
+        if said[0] == NO_END:
+            assert said[1].strip() == source_lines(text)[-1].strip() and NO_END in e.value.rule
+            assert source_lines(text)[e.value.line - 1].startswith("o100 sub")
+        else:
+            assert source_lines(text)[e.value.line - 1].strip() == said[1].strip(), said

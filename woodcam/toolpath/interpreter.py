@@ -45,7 +45,11 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   definition, or the one a call found or a loop passed) is refused, as LinuxCNC 2.9 does;
   so is an if/while/do/repeat line reached with a label another such line reached before holds
   (labels are kept per subroutine, subprogram or main program, across calls: 'duplicate O-word
-  label'; a second do loop's test would go back to the first do);
+  label'; a second do loop's test would go back to the first do); as LinuxCNC, an endsub or
+  return outside every definition is refused when reached, and a sub defined inside another,
+  one never closed and text after ``oN sub`` when the program passes over the definition (the
+  moves before run; after M2 or in a branch not taken, never), text after an endsub's value
+  only when a call returns there (passing over, the value alone is read);
 - Fanuc-style subprograms (LinuxCNC 2.9's "Fanuc-Style Numbered Programs", measured against
   its interpreter): ``M98 P1000 L2`` (the first word of its line, before any comment, as
   ``O`` words and the returning ``M99``; only P and L on it) calls
@@ -1206,6 +1210,10 @@ class Interpreter:
                                   "line"))
         try:
             self._match_structure(lines)
+            if late_owords and self.refused_at:
+                # an O word after a comment (which LinuxCNC reads as none) may be why the labels
+                # do not match: refused now, at that line, as a mismatch is (the first found)
+                raise next(iter(self.refused_at.values()))
         except GcodeError as e:
             blame = self._late_blame(lines, late_owords, e)
             if blame is None:
@@ -1254,6 +1262,10 @@ class Interpreter:
         self._breaks: dict[int, list[int]] = {}  # loop opener index -> its break lines' indices
         # if/while/do/repeat index -> the indices of those nested in it with its label
         self._inner_same: dict[int, list[int]] = {}
+        # line index -> the error LinuxCNC raises when the program reaches that line (an endsub
+        # or return outside every definition), or passes over the definition there (one holding
+        # another sub's): it runs the lines before, and a line never reached is never refused
+        self.refused_at: dict[int, GcodeError] = {}
         stack: list[tuple[str, str, int]] = []
         self.olabels: dict[str, list[int]] = {}  # bare O label -> its line indices
         for idx, ln in enumerate(lines):
@@ -1286,9 +1298,20 @@ class Interpreter:
                         if s[1] == ln.olabel and s[0] != "sub":
                             self._inner_same.setdefault(s[2], []).append(idx)
                 if k == "sub":
-                    if any(s[0] == "sub" for s in stack):
-                        raise GcodeError(ln.no, f"o{ln.olabel} sub", "subroutine defined inside "
-                                       "another", "move it out")
+                    outer = next((s for s in stack if s[0] == "sub"), None)
+                    if outer is not None:
+                        # LinuxCNC refuses it as it passes over the outer definition ('Nested
+                        # subroutine definition'); a call of the outer sub runs through this
+                        # line, and an endsub of this label there returns from that call
+                        # (below): so the line is no O word, and the outer sub is refused when
+                        # passed over, at this line
+                        self.refused_at.setdefault(outer[2], GcodeError(
+                            ln.no, f"o{ln.olabel} sub", f"subroutine o{ln.olabel} defined inside "
+                            f"the o{outer[1]} sub of line {lines[outer[2]].no}: LinuxCNC refuses "
+                            "it when the program passes over that definition ('Nested "
+                            "subroutine definition')", "move it out"))
+                        ln.okey = "nested"
+                        continue
                     self.subs.setdefault(ln.olabel, idx)
                     self.sub_defs.setdefault(ln.olabel, []).append(idx)
                 stack.append((k, ln.olabel, idx))
@@ -1306,6 +1329,15 @@ class Interpreter:
                                       f"o{sub[1]}'s return (a call of o{sub[1]} ends here, "
                                       f"its lines after it never run), and so does woodcam; "
                                       f"write o{sub[1]} return (or fix the label)"))
+            elif k in ("endsub", "return") and not any(s[0] == "sub" for s in stack):
+                # outside every definition: LinuxCNC refuses it only when it reaches it ('not in
+                # a subroutine definition'): after M2, or in a branch not taken, it never does
+                self.refused_at[idx] = GcodeError(
+                    ln.no, f"o{ln.olabel} {k}", f"{k} outside a subroutine definition (no "
+                    f"o{ln.olabel} sub is open here; LinuxCNC: 'not in a subroutine definition')",
+                    "match the O-word labels, or use M2 to end the program" if k == "return"
+                    else "match the O-word labels")
+                ln.okey = "refused"
             elif k in ("endsub", "endif", "endwhile", "endrepeat"):
                 want = {"endsub": "sub", "endif": "if", "endwhile": "while",
                         "endrepeat": "repeat"}[k]
@@ -1331,22 +1363,25 @@ class Interpreter:
                 self.owner[idx] = loop[2]
                 if k == "break":
                     self._breaks.setdefault(loop[2], []).append(idx)
-            elif k == "return":
-                sub = next((s for s in reversed(stack) if s[0] == "sub"), None)
-                if sub is None:
-                    raise GcodeError(ln.no, f"o{ln.olabel} return", "return outside a "
-                                   "subroutine", "use M2 to end the program")
+            elif k == "return":  # (outside every definition: refused when reached, above)
+                sub = next(s for s in reversed(stack) if s[0] == "sub")
                 self.owner[idx] = sub[2]
         if stack:
             k, label, idx = stack[-1]
             sub = next((s for s in stack if s[0] == "sub"), None)
             if sub is not None:  # LinuxCNC passes over a definition to its endsub: to the end
                 k, label, idx = sub
-                raise GcodeError(lines[idx].no, f"o{label} sub", f"o{label} sub is never "
-                                 f"closed by an o{label} endsub: LinuxCNC reads the rest of the "
-                                 "file as its definition, runs none of it and stops at the end "
-                                 "('File ended with no percent sign or program end')",
-                                 f"end the definition with o{label} endsub")
+                unclosed = GcodeError(lines[idx].no, f"o{label} sub", f"o{label} sub is never "
+                                      f"closed by an o{label} endsub: LinuxCNC reads the rest of "
+                                      "the file as its definition, runs none of it and stops at "
+                                      "the end ('File ended with no percent sign or program "
+                                      f"end')", f"end the definition with o{label} endsub")
+                if stack[0] is not sub:  # an if or loop open before it: never matched
+                    raise unclosed
+                # refused when the program reaches it (or calls it): the lines before it run,
+                # as in LinuxCNC (a sub after the program's M2 is never read)
+                self.refused_at[idx] = unclosed
+                return
             raise GcodeError(lines[idx].no, f"o{label} {k}", f"o{label} {k} is never closed",
                            "close it")
 
@@ -1406,11 +1441,23 @@ class Interpreter:
                 pc += 1
                 continue
             if k == "sub":
+                if pc in self.refused_at:  # a sub defined inside it
+                    raise self.refused_at[pc]
+                if ln.oexpr:  # LinuxCNC reads the line as it passes over the definition (a call
+                    # that finds the definition searching forward does not read it)
+                    raise self.err(f"o{ln.olabel} sub{ln.oexpr}", "text after o"
+                                   f"{ln.olabel} sub (LinuxCNC: 'Unexpected character after "
+                                   "O-word'; a sub takes its arguments as #1, #2, ... from the "
+                                   "call)", f"write o{ln.olabel} sub alone on its line")
                 self._define_sub(pc, ln)
                 # LinuxCNC reads the definition's endsub as it passes over the body (not a
                 # return in it): #<_value> becomes its value, 0 without one, though no call ran
                 self._returned(lines[self.match[pc]], definition=True)
                 pc = self.match[pc] + 1
+            elif k == "refused":
+                raise self.refused_at[pc]
+            elif k == "nested":  # a sub line inside a definition, reached in a call: LinuxCNC
+                pc += 1  # runs on through it (its definition refused when passed over: above)
             elif k == "o":  # a program number: run through it, as LinuxCNC and Fanuc (never
                 # inside an o-word sub: _prepare refuses one in a definition)
                 pc += 1
@@ -1440,6 +1487,8 @@ class Interpreter:
                                    "would search its SUBROUTINE_PATH)",
                                    "define it in the program")
                 target = self._sub_target(pc, ln)
+                if target not in self.match:  # a definition never closed (_match_structure)
+                    raise self.refused_at[target]
                 args = self._call_args(ln.oexpr)
                 saved = {i: self.p.get(i, 0.0) for i in range(1, 31)}
                 frames.append((pc + 1, saved, self.locals, target, ln.olabel, ln.no))
@@ -1801,15 +1850,26 @@ class Interpreter:
         self._value_unknown = None  # a definition's unreadable endsub value is replaced
         return ret
 
-    def _cond(self, ln):
+    def _cond(self, ln, definition: bool = False):
+        """The value of the ``[...]`` of O-word line ``ln`` and where it ends in ``ln.oexpr``.
+        ``definition``: ``ln`` is the endsub of a definition passed over, which LinuxCNC reads
+        only up to its value: text after it (or text instead of one: no value, ``(None, 0)``)
+        is refused only when a call returns there."""
         s = ln.oexpr
         what = "value" if ln.okey in ("return", "endsub") else "condition"
+        if definition and not s.startswith("["):
+            return None, 0
+        if what == "value" and not s.startswith("["):
+            raise self.err(f"o{ln.olabel} {ln.okey}{s}", f"text after o{ln.olabel} {ln.okey} "
+                           "(LinuxCNC: 'Unexpected character after O-word')", f"remove it, or "
+                           f"give the value in [ ]: o{ln.olabel} {ln.okey} [...]")
         if not s.startswith("["):
             raise self.err(f"o{ln.olabel} {ln.okey}{s}", f"{ln.okey} needs a [{what}]",
                            f"write o{ln.olabel} {ln.okey} [...]")
         v, i = self.value(s, 0)
-        if s[i:]:
-            raise self.err(s[i:], f"text after the {what}", "remove it")
+        if s[i:] and not definition:
+            said = " (LinuxCNC: 'Unexpected character after O-word')" if what == "value" else ""
+            raise self.err(s[i:], f"text after the {what}{said}", "remove it")
         return v, i
 
     def _returned(self, ln, definition: bool = False) -> None:
@@ -1823,7 +1883,7 @@ class Interpreter:
         if ln.oexpr:
             self.line_no, self._defining = ln.no, definition
             try:
-                v = self._cond(ln)[0]
+                v = self._cond(ln, definition)[0]
             except _Unread as e:
                 v = 0.0
                 self._value_unknown = (
