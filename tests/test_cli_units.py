@@ -589,3 +589,25 @@ def test_the_units_help_says_the_messages_speak_it():
         assert "the lengths in warnings and errors" in action.help, (command, action.help)
     review = next(a for a in commands["review"]._actions if a.dest == "units")
     assert "files written (the page's measurements too) stay mm" in review.help
+
+
+@pytest.mark.parametrize("units, option, value, says", [
+    # a rate: --rapid-rate 0.001 (inch/min) was refused as '[0.1, 1e+06] mm; got 0.001 inch =
+    # 0.0254 mm', a length where the option reads a length per minute
+    ("inch", "--rapid-rate", "0.001", "--rapid-rate must be in [0.1, 1e+06] mm/min; got 0.001 "
+                                      "inch/min = 0.0254 mm/min;"),
+    ("mm", "--rapid-rate", "0.001", "--rapid-rate must be in [0.1, 1e+06] mm/min; got 0.001 mm/min;"),
+    ("inch", "--rapid-rate", "nan", "--rapid-rate must be a finite number in [0.1, 1e+06] mm/min; "
+                                    "got nan inch/min;"),
+    # a length under --units mm said no unit at all: '[0.005, 10]; got 20.0'
+    ("mm", "--cell-size", "20", "--cell-size must be in [0.005, 10] mm; got 20.0 mm;"),
+    ("inch", "--cell-size", "0.5", "--cell-size must be in [0.005, 10] mm; got 0.5 inch = 12.7 mm;"),
+    ("mm", "--start", "0,0,1e9", "--start must be in [-100000, 100000] mm; got 1000000000.0 mm;"),
+])
+def test_a_range_error_says_the_unit_of_the_range_and_the_value(units, option, value, says, tmp_path,
+                                                               capsys):
+    prog = tmp_path / "p.nc"
+    prog.write_text("G21\nG0 X1 Z2\nM2\n")
+    assert main(["gcode", str(prog), "--block", "builtin:flat-sawn", "--tool", "flat:3", "--out",
+                 str(tmp_path / "o.glb"), "--units", units, option, value]) == 2
+    assert says in capsys.readouterr().err

@@ -20,11 +20,11 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
 # (woodcam.cli.options.check_inputs, tests/test_cli_inputs.py)
 @pytest.mark.parametrize("argv, code, match", [
     (["gcode", "toolpaths/vcarve_text.nc", "--tool", "vbit:60:12", "--block", "builtin:flat-sawn",
-      "--out", "OUT/x.glb", "--resolution", "1e-9"], EXIT_USAGE, r"--cell-size must be in \[0.005, 10\]"),
-    ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "0"], EXIT_USAGE, r"--tolerance must be in \(0, 10\]; got 0.0"),
+      "--out", "OUT/x.glb", "--resolution", "1e-9"], EXIT_USAGE, r"--cell-size must be in \[0.005, 10\] mm; got 1e-09 mm"),
+    ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "0"], EXIT_USAGE, r"--tolerance must be in \(0, 10\] mm; got 0.0 mm"),
     # sweep h2: a non-finite number was told neither the range nor the help ("got nan" and no fix)
     ([*BAKE, "--out", "OUT/x.glb", "--tolerance", "nan"], EXIT_USAGE,
-     r"--tolerance must be a finite number in \(0, 10\]; got nan; see 'woodcam bake --help' for its meaning and default$"),
+     r"--tolerance must be a finite number in \(0, 10\] mm; got nan mm; see 'woodcam bake --help' for its meaning and default$"),
     ([*BAKE, "--out", "OUT/x.glb", "--texels-per-mm", "inf"], EXIT_USAGE, r"--texels-per-mm must be a finite"),
     ([*BAKE, "--out", "OUT/x.glb", "--texels-per-mm", "1e6"], EXIT_USAGE, r"--texels-per-mm must be in"),
     ([*BAKE, "--out", "OUT/x.glb", "--timeout=-1"], EXIT_USAGE, r"--timeout must be in \(0"),
@@ -42,7 +42,7 @@ GCODE = ["gcode", "toolpaths/drilling.nc", "--block", "builtin:flat-sawn", "--ou
     ([*BAKE, "--out", "OUT/objdir/x.glb"], EXIT_USAGE, r"--out \(the OBJ beside the GLB; --no-obj skips it\): .*x.obj' is an "
      r"existing folder"),
     # an infinite machining time was an OverflowError traceback
-    ([*GCODE, "--tool", "flat:6", "--start=1e300,0,0"], EXIT_USAGE, r"--start must be in \[-100000, 100000\]; got 1e\+300"),
+    ([*GCODE, "--tool", "flat:6", "--start=1e300,0,0"], EXIT_USAGE, r"--start must be in \[-100000, 100000\] mm; got 1e\+300 mm"),
     ([*GCODE, "--tool", "flat:6", "--rapid-rate", "1e-320"], EXIT_USAGE, r"--rapid-rate must be in \[0.1, 1e\+06\]"),
     # a stock of 1e300 mm: the message printed a 300-digit grid (read at the door in --units)
     ([*GCODE, "--tool", "flat:6", "--stock", "1e300x10x10"], EXIT_USAGE,

@@ -1624,11 +1624,18 @@ def _bound(v) -> str:
     return f"{v:g}" if float(f"{v:g}") == v else (f"{v:d}" if isinstance(v, int) else repr(v))
 
 
-def _span(rng, mm: bool = False) -> str:
-    """A RANGES entry as the errors and the help say it: ``[1, 1e+06]``, ``(0, 100]``."""
+def _span(rng, mm: bool = False, per: str = "") -> str:
+    """A RANGES entry as the errors and the help say it: ``[1, 1e+06]``, ``(0, 100]``; with ``mm``
+    in mm, ``per`` after it (``"/min"``: a rate, ``[0.1, 1e+06] mm/min``)."""
     lo, hi, lo_open, hi_open = (*rng, False)[:4]
     return (f"{'(' if lo_open else '['}{_bound(lo)}, {_bound(hi)}{')' if hi_open else ']'}"
-            f"{' mm' if mm else ''}")
+            f"{' mm' + per if mm else ''}")
+
+
+#: Options read in --units per minute (a rate, not a length): their range and the value typed
+#: say "mm/min" and "inch/min" (--rapid-rate 0.001 under --units inch was refused as
+#: "must be in [0.1, 1e+06] mm; got 0.001 inch = 0.0254 mm").
+PER_MINUTE_OPTIONS = {("gcode", "rapid_rate")}
 
 
 def option_range(dest: str, command: str | None = None) -> str:
@@ -1644,7 +1651,12 @@ def option_bounds(dest: str, command: str | None = None) -> tuple | None:
     return None if rng is None else tuple(limit(b) if isinstance(b, str) else b for b in rng)
 
 
-def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND", cap: str = "") -> None:
+def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND", cap: str = "",
+                 per: str = "", length: bool = False) -> None:
+    """Refuse ``value`` of ``option`` outside ``rng`` (a :data:`RANGES` entry). ``typed``:
+    ``(value as typed, its unit)`` of a length read in --units (then ``value`` is mm); ``per``:
+    ``"/min"`` for a rate; ``length``: a length option (:data:`LENGTH_OPTIONS`), whose range and
+    value say mm under --units mm too (they said '[0.005, 10]; got 20.0' of --cell-size)."""
     # a UsageError (exit 2): a number out of range is a wrong command line, as the exit statuses
     # in 'woodcam --help' say (it exited 1, as a failed work)
     from ..errors import UsageError
@@ -1653,14 +1665,16 @@ def _check_value(value, option: str, rng, typed=None, command: str = "COMMAND", 
         return
     help_ = f"see 'woodcam {command} --help' for its meaning and default"
     lo, hi, lo_open, hi_open = (*rng, False)[:4] if rng is not None else (None, None, False, False)
-    span = "" if rng is None else _span(rng, typed is not None)
+    span = "" if rng is None else _span(rng, typed is not None or length, per)
     if isinstance(value, float) and not math.isfinite(value):  # the range and the help too (it said neither)
-        got = repr(value) if typed is None else f"{typed[0]!r} {typed[1]}"
+        got = (f"{value!r}{' mm' + per if length else ''}" if typed is None
+               else f"{typed[0]!r} {typed[1]}{per}")
         raise UsageError(f"{option} must be a finite number{' in ' + span if span else ''}; got {got}; {help_}")
     if rng is None:
         return
     if value < lo or value > hi or (lo_open and value <= lo) or (hi_open and value >= hi):
-        got = f"{value!r}" if typed is None else f"{typed[0]!r} {typed[1]} = {value:g} mm"
+        got = (f"{value!r}{' mm' + per if length else ''}" if typed is None
+               else f"{typed[0]!r} {typed[1]}{per} = {value:g} mm{per}")
         raise UsageError(f"{option} must be in {span}; got {got}; {help_}"
                          + (f"; raise it with WOODCAM_{cap}=N" if cap and value > hi else ""))
 
@@ -1683,7 +1697,9 @@ def check_numbers(args: argparse.Namespace) -> None:
                 item = (typed[0][i], typed[1]) if isinstance(typed[0][i], (int, float)) else None
             else:
                 item = typed
-            _check_value(v, _option(dest), rng, item, name or "COMMAND", cap)
+            _check_value(v, _option(dest), rng, item, name or "COMMAND", cap,
+                         "/min" if (command, dest) in PER_MINUTE_OPTIONS else "",
+                         LENGTH_OPTIONS.get((command, dest)) in ("number", "vector", "sizes"))
 
 
 def add_workers_option(p: argparse.ArgumentParser, note: str = "") -> None:
