@@ -186,6 +186,10 @@ def test_place_in_inches_ranks_what_the_mm_run_ranks_and_prints_inches(tmp_path,
     assert printed == ",".join(f"{v / 25.4:.4f}" for v in mm), printed
     assert all(len(op.split(":")[1].split(",")[0].split(".")[1]) == 3
                for r in rec["in"]["ranked"] for op in r["ops"] if op.startswith("translate:"))
+    # the inch numbers say their unit and how bake reads them: typed into 'woodcam bake' without
+    # --units inch they moved the part that many mm (the column said only "place")
+    assert out_inch.splitlines()[0].endswith("  place (lengths in inches: woodcam bake --units inch)")
+    assert out_mm.splitlines()[0].endswith("runout  place")
 
 
 def test_gcode_deviation_and_gouges_print_in_inches(tmp_path, monkeypatch, capsys):

@@ -66,10 +66,11 @@ class PlacementAdvice:
     elongation: float
     weights: dict[str, float] = field(default_factory=dict)
 
-    def table(self, top: int = 5, op_text: Callable[[str], str] = str) -> str:
+    def table(self, top: int = 5, op_text: Callable[[str], str] = str, place_title: str = "place") -> str:
         """The top placements as text, one line each, with every term; ``op_text`` writes each
-        --place operation (e.g. its lengths in the user's unit)."""
-        lines = [f"{'rank':>4} {'score':>6} {'knots':>6} {'pith':>6} {'end':>6} {'runout':>6}  place"]
+        --place operation (e.g. its lengths in the user's unit), under the column title
+        ``place_title`` (which says that unit where it is not mm)."""
+        lines = [f"{'rank':>4} {'score':>6} {'knots':>6} {'pith':>6} {'end':>6} {'runout':>6}  {place_title}"]
         for i, p in enumerate(self.ranked[:top], 1):
             t = p.terms
             lines.append(f"{i:>4} {p.score:6.3f} {t['knots']:6.3f} {t['pith']:6.3f} "

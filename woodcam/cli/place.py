@@ -86,8 +86,12 @@ def run_place(args: argparse.Namespace) -> int:
         write_bytes(out / "placements.json", json.dumps(record, indent=1).encode())
         with bar.stage("render"):
             png = render_advice(advice, part, stock, out / "placements.png", top=args.top, progress=True)
-    # the --place ops to type back, rounded for the unit (--units inch: 1.9685, not 1.96850393701)
-    print(advice.table(args.top, op_text=lambda op: place_op_in(op, k, TYPED_DECIMALS[args.units])))
+    # the --place ops to type back, rounded for the unit (--units inch: 1.9685, not 1.96850393701);
+    # in inches the column says so, and how bake reads them: typed into 'woodcam bake' without
+    # --units inch, translate:-0.95,... moved the part 0.95 mm (the numbers carried no unit)
+    title = "place" if args.units == "mm" else f"place (lengths in inches: woodcam bake --units {args.units})"
+    print(advice.table(args.top, op_text=lambda op: place_op_in(op, k, TYPED_DECIMALS[args.units]),
+                       place_title=title))
     # a panel per placement up to --top 100000 took minutes: the picture stops at MAX_PANELS
     listed = min(args.top, len(advice.ranked))
     drawn = f" (the best {MAX_PANELS} and the worst; the table lists {listed})" if listed > MAX_PANELS else ""
