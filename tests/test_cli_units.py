@@ -615,3 +615,16 @@ def test_a_range_error_says_the_unit_of_the_range_and_the_value(units, option, v
     assert main(["gcode", str(prog), "--block", "builtin:flat-sawn", "--tool", "flat:3", "--out",
                  str(tmp_path / "o.glb"), "--units", units, option, value]) == 2
     assert says in capsys.readouterr().err
+
+
+def test_a_small_volume_or_area_is_said_without_an_exponent():
+    """A 1 mm^3 part baked under --units inch was summed up as '6.102e-05 in^3' (fmt_volume:
+    'never in exponent form' held for large volumes only); small volumes and areas are written
+    out to their four significant digits, in every unit."""
+    from woodcam.units import say_area, say_volume
+
+    assert fmt_volume(1.0, "inch") == "0.00006102 in^3"
+    assert fmt_volume(1e-5) == "0.00001 mm^3" and say_volume(2.5e-6) == "0.0000025 mm^3"
+    assert say_area(1e-3, units="inch") == "0.00000155 in^2"
+    assert fmt_volume(25.4 ** 3 * 2, "inch") == "2 in^3" and fmt_volume(1.518) == "1.518 mm^3"
+    assert "e" not in fmt_volume(-1e-9, "inch")

@@ -72,7 +72,7 @@ def fmt_volume(mm3: float, units: Units = "mm") -> str:
     under 1000 mm^3 four significant digits, as inches get (``"1.518 mm^3"``, not ``"2 mm^3"``);
     never in exponent form (a 60x50x20 in block's leftover was '6e+04 in^3')."""
     if units == "mm":
-        return f"{mm3:.0f} mm^3" if abs(mm3) >= 1000 else f"{mm3:.4g} mm^3"
+        return f"{mm3:.0f} mm^3" if abs(mm3) >= 1000 else f"{_no_exponent(mm3, '.4g')} mm^3"
     return f"{_no_exponent(mm3 / MM_PER_UNIT[units] ** 3, '.4g')} {_SYMBOL[units]}^3"
 
 
@@ -143,11 +143,18 @@ def say_volume(mm3: float, spec: str = ".4g", *, units: Units | None = None) -> 
 
 
 def _no_exponent(value: float, spec: str) -> str:
-    """``value`` with ``spec``, a large one written out as the rounded whole number it is, never
-    in exponent form: ``.4g`` of 110000 mm^3 was '1.1e+05' beside '120000 mm^3' in one message
-    (the part sticking out of its block)."""
+    """``value`` with ``spec``, never in exponent form: a large one written out as the rounded
+    whole number it is (``.4g`` of 110000 mm^3 was '1.1e+05' beside '120000 mm^3' in one message,
+    the part sticking out of its block), a small one as the decimals of its significant digits
+    (a 1 mm^3 part baked under ``--units inch`` was '6.102e-05 in^3', now '0.00006102 in^3')."""
     text = f"{value:{spec}}"
-    return f"{float(text):.0f}" if "e+" in text else text
+    if "e+" in text:
+        return f"{float(text):.0f}"
+    if "e-" in text:
+        mantissa, exponent = text.split("e-")
+        decimals = len(mantissa.partition(".")[2]) + int(exponent)
+        return f"{float(text):.{decimals}f}"
+    return text
 
 
 def say_area(mm2: float, spec: str = ".4g", *, units: Units | None = None) -> str:
@@ -157,7 +164,7 @@ def say_area(mm2: float, spec: str = ".4g", *, units: Units | None = None) -> st
     units = units or _message_units
     if units == "mm":
         return f"{_no_exponent(mm2, spec)} mm^2"
-    return f"{mm2 / MM_PER_UNIT[units] ** 2:.4g} {_SYMBOL[units]}^2"
+    return f"{_no_exponent(mm2 / MM_PER_UNIT[units] ** 2, '.4g')} {_SYMBOL[units]}^2"
 
 
 class _Said(str):

@@ -60,7 +60,7 @@ def test_a_part_too_small_to_carve_says_so():
     """A 0.02 mm part inside the block was said not to intersect it, with the advice to move it by
     (0, 0, 0) mm."""
     part = manifold3d.Manifold.cube((0.02, 0.02, 0.02)).translate((50, 40, 25))
-    with pytest.raises(WoodcamError, match=r"the part's volume is 8e-06 mm\^3 \(it measures 0.02x0.02x0.02 mm\), too small to carve; "
+    with pytest.raises(WoodcamError, match=r"the part's volume is 0.000008 mm\^3 \(it measures 0.02x0.02x0.02 mm\), too small to carve; "
                        r"check its units"):
         carve(part, DEMO_BLOCK_MM)
 
