@@ -628,3 +628,26 @@ def test_a_small_volume_or_area_is_said_without_an_exponent():
     assert say_area(1e-3, units="inch") == "0.00000155 in^2"
     assert fmt_volume(25.4 ** 3 * 2, "inch") == "2 in^3" and fmt_volume(1.518) == "1.518 mm^3"
     assert "e" not in fmt_volume(-1e-9, "inch")
+
+
+def test_the_reach_issues_of_an_inch_run_are_filed_in_mm(tmp_path, monkeypatch, capsys):
+    """The GLB's metadata copy of the simulation issues (the review page's hotspots) stays mm
+    under --units inch, as the other issues' (review h15 item 7): the reach checks' messages
+    (deeper_than_flute, shank and holder) were built with say_length alone, so the file said
+    'cuts 1.18 in deep with 0.5 in of flute' beside 'cuts up to 1.000 mm into the stock'."""
+    meta = {}
+    monkeypatch.setattr(woodcam.pipeline, "preview_heightfield",
+                        lambda hm, stock, out, **kw: meta.update(kw["metadata"]) or woodcam.pipeline.PartPreview(
+                            "x", files={"glb": out}, triangles=1))
+    prog = tmp_path / "p.nc"
+    prog.write_text("G20\nM3 S1000\nG0 X1 Y1 Z0.1\nG1 Z-0.9 F30\nX3\nG0 Z0.1\nM5\nM2\n")
+    assert main(["gcode", str(prog), "--units", "inch", "--block", "builtin:flat-sawn:4x3x1",
+                 "--tool", "flat:0.25:flute=0.5:holder=1:stickout=0.7", "--cell-size", "0.04",
+                 "--out", str(tmp_path / "g.glb")]) == 0
+    err = capsys.readouterr().err
+    said = [ln for ln in err.splitlines() if "deeper_than_flute" in ln or "holder_collision" in ln]
+    assert len(said) == 2 and all(" mm" not in ln and " in " in ln for ln in said), err
+    filed = [w["message"] for w in meta["warnings"]
+             if "deeper_than_flute" in w["message"] or "holder_collision" in w["message"]]
+    assert len(filed) == 2 and all(" mm" in m and " in " not in m for m in filed), filed
+    assert any("deep with 12.7 mm of flute" in m for m in filed), filed

@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..tolerances import REACH_GRID_MM, REACH_TOL_MM
-from ..units import say_length
+from ..units import said, say_length
 
 #: Issue kinds of this check (see :class:`woodcam.toolpath.simulate.Issue`).
 REACH_KINDS = ("deeper_than_flute", "shank_collision", "holder_collision")
@@ -106,18 +106,21 @@ def reach_issues(p0, p1, tool_of, lookup, lines, size_mm, initial_heightmap=None
                                 max(r, R) + max(dx, dy) if name == "shank" else r, bottom)
             if e <= REACH_TOL_MM:
                 continue
+            # said(): the message keeps its mm text for the files (the GLB's issue spots, which
+            # the review page shows): it was filed in inches under --units inch, beside the
+            # other issues' mm
             if name == "holder":
-                out.append(("holder_collision", int(lines[k]),
-                            f"the {say_length(2 * r, 'g')} holder ({say_length(bottom, 'g')} above the tip) "
-                            f"meets the stock {say_length(e, '.2f')} deep", e))
+                out.append(("holder_collision", int(lines[k]), said(lambda: (
+                    f"the {say_length(2 * r, 'g')} holder ({say_length(bottom, 'g')} above the tip) "
+                    f"meets the stock {say_length(e, '.2f')} deep")), e))
             elif d2 <= (R + max(dx, dy)) ** 2:
-                out.append(("deeper_than_flute", int(lines[k]),
-                            f"cuts {say_length(e + bottom, '.2f')} deep with {say_length(bottom, 'g')} of "
-                            f"flute: the shank rubs {say_length(e, '.2f')} of stock above the flutes", e))
+                out.append(("deeper_than_flute", int(lines[k]), said(lambda: (
+                    f"cuts {say_length(e + bottom, '.2f')} deep with {say_length(bottom, 'g')} of "
+                    f"flute: the shank rubs {say_length(e, '.2f')} of stock above the flutes")), e))
             else:
-                out.append(("shank_collision", int(lines[k]),
-                            f"the {say_length(2 * r, 'g')} shank meets the stock {say_length(e, '.2f')} "
-                            f"above the flutes ({say_length(bottom, 'g')})", e))
+                out.append(("shank_collision", int(lines[k]), said(lambda: (
+                    f"the {say_length(2 * r, 'g')} shank meets the stock {say_length(e, '.2f')} "
+                    f"above the flutes ({say_length(bottom, 'g')})")), e))
     return out
 
 
