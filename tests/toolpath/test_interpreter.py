@@ -1411,6 +1411,15 @@ SUB_LINE_PROGRAMS = [
     ("G1 X1 F100\nM2\no100 sub\no101 sub\no101 endsub\no100 endsub\n", [(1, 0, 0)], None),
     ("G1 X1 F100\no100 call [2]\nG1 X3\nM2\no100 sub\nG1 X#1\no101 sub\nG1 X9\no101 endsub\n"
      "G1 X4\no100 endsub\n", [(1, 0, 0), (2, 0, 0), (9, 0, 0), (3, 0, 0)], None),
+    # a return in a definition passed over is read as the endsub is, in order: its value set
+    # (the endsub's [#<_value>+1] reads 5), one it cannot compute refused there, before the
+    # moves after the body; the text after it and a parameter without a value left for a call
+    ("o100 sub\nG1 X#1 F100\no100 return [1/0]\no100 endsub\nG1 Y1 F100\no100 call [2]\nM2\n",
+     [], 3),
+    ("o100 sub\no100 return [5]\no100 endsub [#<_value>+1]\nG1 Y#<_value> F100\nM2\n",
+     [(0, 6, 0)], None),
+    ("o100 sub\no100 return [2] G1 X9\no100 endsub\nG1 Y1 F100\nM2\n", [(0, 1, 0)], None),
+    ("o100 sub\no100 return [#<nope>]\no100 endsub\nG1 Y1 F100\nM2\n", [(0, 1, 0)], None),
     # a sub never closed: nothing after M2 is read; reached, refused at its line (rs274 says
     # 'File ended ...' at the file's last, the line it got to looking for the endsub)
     ("G1 X1 F100\nM2\no100 sub\nG1 X2\n", [(1, 0, 0)], None),

@@ -10,7 +10,8 @@ What it reads (LinuxCNC's "G-code overview" and "O codes" chapters)
   as ``#<_x>``...; A-W read 0: woodcam has no such axes), ``#5599`` (1), ``#5600``/``#5601``
   (0: no tool-changer faults), ``#<_value>`` and ``#<_value_returned>`` (the value of the last
   ``return [v]`` or ``endsub [v]``, and 1 if it had one; LinuxCNC reads a definition's
-  ``endsub [v]`` as it passes over it, and so does woodcam), LinuxCNC 2.9's other predefined
+  ``return [v]`` lines and its ``endsub [v]``, in order, as it passes over it, and so does
+  woodcam), LinuxCNC 2.9's other predefined
   named parameters (:data:`_PREDEFINED`: modes, spindle, coolant, overrides, tools, call
   level, version; ``#<_task>`` is 1, the machine's value; the tool changer's pockets and
   ``#<_vminor>`` are refused: woodcam cannot know them); read-only ones (``#5400``-``#5413``,
@@ -1450,8 +1451,14 @@ class Interpreter:
                                    "O-word'; a sub takes its arguments as #1, #2, ... from the "
                                    "call)", f"write o{ln.olabel} sub alone on its line")
                 self._define_sub(pc, ln)
-                # LinuxCNC reads the definition's endsub as it passes over the body (not a
-                # return in it): #<_value> becomes its value, 0 without one, though no call ran
+                # LinuxCNC reads the definition's returns and its endsub as it passes over the
+                # body, in order (not its ifs or loops): #<_value> becomes the last value, 0
+                # where the endsub has none, though no call ran, and a value it cannot compute
+                # ('o100 return [1/0]') is refused on its line before any line after the body
+                # runs (woodcam cut the moves up to a call and refused there)
+                for i in range(pc + 1, self.match[pc]):
+                    if lines[i].okey == "return" and self.owner.get(i) == pc:
+                        self._returned(lines[i], definition=True)
                 self._returned(lines[self.match[pc]], definition=True)
                 pc = self.match[pc] + 1
             elif k == "refused":
@@ -1875,9 +1882,10 @@ class Interpreter:
     def _returned(self, ln, definition: bool = False) -> None:
         """Set ``#<_value>`` and ``#<_value_returned>`` as LinuxCNC's ``return`` or ``endsub``
         line ``ln`` does: ``o1 return [v]`` and ``o1 endsub [v]`` alike give ``v`` and 1,
-        either without a value 0 and 0. ``definition``: ``ln`` closes a definition passed
-        over, where a parameter without a value leaves ``#<_value>`` unknown (refused when
-        read) instead of refusing the program."""
+        either without a value 0 and 0. ``definition``: ``ln`` is read as the program passes
+        over its definition (a return in it, then its endsub), where a parameter without a
+        value leaves ``#<_value>`` unknown (refused when read) instead of refusing the program,
+        and text after the value is left for a call to refuse."""
         v = None
         self._value_unknown = None
         if ln.oexpr:
@@ -1887,7 +1895,7 @@ class Interpreter:
             except _Unread as e:
                 v = 0.0
                 self._value_unknown = (
-                    f"o{ln.olabel} endsub on line {ln.no} set #<_value> where its subroutine "
+                    f"o{ln.olabel} {ln.okey} on line {ln.no} set #<_value> where its subroutine "
                     f"is defined, before any call, and there {e} has no value (LinuxCNC reads "
                     "undefined memory for it)")
             finally:
