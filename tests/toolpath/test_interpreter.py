@@ -215,8 +215,10 @@ def test_o_word_structure_errors():
     with pytest.raises(GcodeError, match="never closed") as e:
         _ends("G0 X1\no1 if [1]\nG0 X2\nM2\n")
     assert e.value.line == 2
+    with pytest.raises(GcodeError, match="o1 while is never closed"):
+        _ends("o1 while [0]\no2 endwhile\nM2\n")  # (the o2 endwhile: refused when reached)
     with pytest.raises(GcodeError, match="without a matching"):
-        _ends("o1 while [0]\no2 endwhile\nM2\n")
+        _ends("o1 while [0]\no2 if [1]\no1 endwhile\no2 endif\nM2\n")
     with pytest.raises(GcodeError, match="not defined in this file"):
         _ends("o<elsewhere> call\nM2\n")
 
@@ -1420,6 +1422,15 @@ SUB_LINE_PROGRAMS = [
      [(0, 6, 0)], None),
     ("o100 sub\no100 return [2] G1 X9\no100 endsub\nG1 Y1 F100\nM2\n", [(0, 1, 0)], None),
     ("o100 sub\no100 return [#<nope>]\no100 endsub\nG1 Y1 F100\nM2\n", [(0, 1, 0)], None),
+    # an endif, else, break ... of a label no if or loop opens: refused when reached ('undefined
+    # O-word label'), never after M2 or in a branch not taken, nor in a sub not called
+    ("G1 Y1 F100\no5 endif\nG1 X2\nM2\n", [(0, 1, 0)], 2),
+    ("G1 Y1 F100\no5 break\nG1 X2\nM2\n", [(0, 1, 0)], 2),
+    ("G1 Y1 F100\no1 if [0]\no5 endwhile\no1 endif\nG1 X2\nM2\n", [(0, 1, 0), (2, 1, 0)], None),
+    ("G1 Y1 F100\nM2\no5 else\no6 continue\n", [(0, 1, 0)], None),
+    ("o100 sub\nG1 X#1 F100\no5 endif\no100 endsub\nG1 Y1 F100\nM2\n", [(0, 1, 0)], None),
+    ("o100 sub\nG1 X#1 F100\no5 endif\no100 endsub\nG1 Y1 F100\no100 call [2]\nM2\n",
+     [(0, 1, 0), (2, 1, 0)], 3),
     # a sub never closed: nothing after M2 is read; reached, refused at its line (rs274 says
     # 'File ended ...' at the file's last, the line it got to looking for the endsub)
     ("G1 X1 F100\nM2\no100 sub\nG1 X2\n", [(1, 0, 0)], None),

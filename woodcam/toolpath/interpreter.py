@@ -1264,11 +1264,23 @@ class Interpreter:
         # if/while/do/repeat index -> the indices of those nested in it with its label
         self._inner_same: dict[int, list[int]] = {}
         # line index -> the error LinuxCNC raises when the program reaches that line (an endsub
-        # or return outside every definition), or passes over the definition there (one holding
-        # another sub's): it runs the lines before, and a line never reached is never refused
+        # or return outside every definition, an endif, else, break ... of a label no if or loop
+        # opens), or passes over the definition there (one holding another sub's): it runs the
+        # lines before, and a line never reached is never refused
         self.refused_at: dict[int, GcodeError] = {}
         stack: list[tuple[str, str, int]] = []
         self.olabels: dict[str, list[int]] = {}  # bare O label -> its line indices
+        # the labels an if or loop opens anywhere: a closer, else, break or continue of another
+        # label LinuxCNC refuses only when it reaches it ('undefined O-word label')
+        opened = {ln.olabel for ln in lines if ln.okey in ("if", "while", "do", "repeat")}
+
+        def undefined(idx: int, ln: _Line, rule: str) -> None:
+            self.refused_at[idx] = GcodeError(
+                ln.no, f"o{ln.olabel} {ln.okey}", f"{rule}: no if or loop has the label o{ln.olabel} "
+                "(LinuxCNC: 'undefined O-word label', when the program reaches it)",
+                "match the O-word labels")
+            ln.okey = "refused"
+
         for idx, ln in enumerate(lines):
             k = ln.okey
             if k is None:
@@ -1339,6 +1351,11 @@ class Interpreter:
                     "match the O-word labels, or use M2 to end the program" if k == "return"
                     else "match the O-word labels")
                 ln.okey = "refused"
+            elif k in ("endif", "endwhile", "endrepeat", "elseif", "else", "break", "continue") \
+                    and ln.olabel not in opened:
+                undefined(idx, ln, {"endif": "endif without an if", "endwhile": "endwhile without a while",
+                                    "endrepeat": "endrepeat without a repeat", "elseif": "elseif without an if",
+                                    "else": "else without an if"}.get(k, f"{k} outside a loop"))
             elif k in ("endsub", "endif", "endwhile", "endrepeat"):
                 want = {"endsub": "sub", "endif": "if", "endwhile": "while",
                         "endrepeat": "repeat"}[k]
