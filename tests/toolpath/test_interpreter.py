@@ -1384,8 +1384,8 @@ def test_a_do_loop_reached_while_skipping_is_run_into_with_a_warning():
 
 
 #: (program, end points of its moves from the origin, the line refused or None), as rs274 -g
-#: (LinuxCNC 2.9) runs them: the o-word sub lines it reads only when the program reaches them
-#: or passes over their definition (test_sub_lines_are_refused_where_rs274_refuses_them, in
+#: (LinuxCNC 2.9) runs them: the o-word lines (of subs, and closers of labels no if or loop
+#: opens) it reads only when the program reaches them or passes over their definition (test_sub_lines_are_refused_where_rs274_refuses_them, in
 #: test_linuxcnc_oracle.py, checks the table against rs274 itself).
 SUB_LINE_PROGRAMS = [
     # text after 'o100 sub': refused as the definition is passed over ...
